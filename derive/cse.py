@@ -1,0 +1,73 @@
+"""Common subexpression elimination over a derivation program, deterministically ordered.
+
+The program's right-hand sides and the outputs are passed to ``sympy.cse`` together, in program
+order, with ``order="canonical"``; the result is a straight-line list of assignments in which
+every temporary comes right before its first use. Assignments that no output needs are dropped.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import sympy as sp
+from rpr3gen_derive.specs import FunctionSpec
+
+
+@dataclass(frozen=True)
+class StraightLine:
+    """Code ready to print: ``assignments`` in order, then ``outputs`` (name, expression)."""
+
+    assignments: tuple[tuple[sp.Symbol, sp.Expr], ...]
+    outputs: tuple[tuple[str, sp.Expr], ...]
+    ops_before: int
+    ops_after: int
+
+
+def count_ops(exprs: list[sp.Expr]) -> int:
+    """Arithmetic and function operations, as ``sympy.count_ops`` counts them."""
+    return sum(int(sp.count_ops(e)) for e in exprs)
+
+
+def _live(spec: FunctionSpec) -> list[tuple[sp.Symbol, sp.Expr]]:
+    """The program's assignments that some output depends on, in program order."""
+    needed: set[sp.Symbol] = set()
+    for _, expr in spec.outputs:
+        needed |= expr.free_symbols
+    live = []
+    for a in reversed(spec.program.assignments):
+        if a.symbol in needed:
+            live.append((a.symbol, a.expr))
+            needed |= a.expr.free_symbols
+    live.reverse()
+    return live
+
+
+def straight_line(spec: FunctionSpec) -> StraightLine:
+    """Eliminate common subexpressions across the whole program of ``spec``."""
+    live = _live(spec)
+    exprs = [expr for _, expr in live] + [expr for _, expr in spec.outputs]
+    ops_before = count_ops(exprs)
+    temporaries, reduced = sp.cse(
+        exprs, symbols=sp.numbered_symbols("x", real=True), order="canonical"
+    )
+    temp_defs = dict(temporaries)
+    temp_order = {sym: k for k, (sym, _) in enumerate(temporaries)}
+    emitted: set[sp.Symbol] = set()
+    lines: list[tuple[sp.Symbol, sp.Expr]] = []
+
+    def emit_temps_of(expr: sp.Expr) -> None:
+        for sym in sorted(expr.free_symbols & temp_defs.keys(), key=temp_order.__getitem__):
+            if sym not in emitted:
+                emit_temps_of(temp_defs[sym])
+                emitted.add(sym)
+                lines.append((sym, temp_defs[sym]))
+
+    for (sym, _), expr in zip(live, reduced[: len(live)], strict=True):
+        emit_temps_of(expr)
+        lines.append((sym, expr))
+    outputs = []
+    for (name, _), expr in zip(spec.outputs, reduced[len(live) :], strict=True):
+        emit_temps_of(expr)
+        outputs.append((name, expr))
+    ops_after = count_ops([expr for _, expr in lines] + [expr for _, expr in outputs])
+    return StraightLine(tuple(lines), tuple(outputs), ops_before, ops_after)

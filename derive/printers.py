@@ -1,0 +1,43 @@
+"""Printers for the generated code: SymPy's NumPy and C99 printers, lightly subclassed.
+
+Squares and small integer powers are expanded to products and half-integer powers to ``sqrt``
+by SymPy's rewriting passes before printing, never by editing printed text.
+"""
+
+from __future__ import annotations
+
+import sympy as sp
+from sympy.codegen.rewriting import create_expand_pow_optimization, optimize
+from sympy.printing.c import C99CodePrinter
+from sympy.printing.numpy import NumPyPrinter
+
+_expand_small_powers = create_expand_pow_optimization(3)
+
+
+def prepare(expr: sp.Expr) -> sp.Expr:
+    """Rewrite ``x**2``, ``x**3`` as products so that printers emit no ``pow`` for them."""
+    return optimize(expr, [_expand_small_powers])
+
+
+class NumpyPrinter(NumPyPrinter):
+    """NumPy code over arrays of samples; names qualified as ``numpy.*``."""
+
+    def __init__(self) -> None:
+        super().__init__({"fully_qualified_modules": True, "inline": True})
+
+
+class CPrinter(C99CodePrinter):
+    """C99 code on ``double``; no ``pow`` for small integer powers (see :func:`prepare`)."""
+
+    def __init__(self) -> None:
+        super().__init__({"math_macros": {}})
+
+
+def numpy_code(expr: sp.Expr) -> str:
+    """One NumPy expression."""
+    return NumpyPrinter().doprint(prepare(expr))
+
+
+def c_code(expr: sp.Expr) -> str:
+    """One C99 expression."""
+    return CPrinter().doprint(prepare(expr))

@@ -1,0 +1,117 @@
+"""Render generated sources from the specs through Jinja2 templates, and write or check them.
+
+Output is byte-identical for identical sources: no dates, versions, paths or hash-seed order.
+The header carries a SHA-256 of the derivation's own files (``derive/*.py`` and templates).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import tempfile
+from collections.abc import Iterable
+from pathlib import Path
+
+import jinja2
+from rpr3gen_derive.cse import straight_line
+from rpr3gen_derive.printers import numpy_code
+from rpr3gen_derive.specs import ACTUATIONS, build_spec
+
+PACKAGE_DIR = Path(__file__).resolve().parent
+TEMPLATE_DIR = PACKAGE_DIR / "templates"
+
+
+def source_hash() -> str:
+    """SHA-256 of every file the generated code is derived from, by relative path and content."""
+    digest = hashlib.sha256()
+    files = sorted(PACKAGE_DIR.glob("*.py")) + sorted(TEMPLATE_DIR.glob("*.jinja"))
+    for path in files:
+        digest.update(path.relative_to(PACKAGE_DIR).as_posix().encode())
+        digest.update(b"\0")
+        digest.update(path.read_bytes().replace(b"\r\n", b"\n"))
+        digest.update(b"\0")
+    return digest.hexdigest()
+
+
+def _environment() -> jinja2.Environment:
+    return jinja2.Environment(
+        loader=jinja2.FileSystemLoader(TEMPLATE_DIR),
+        undefined=jinja2.StrictUndefined,
+        trim_blocks=True,
+        lstrip_blocks=True,
+        keep_trailing_newline=True,
+        autoescape=False,
+    )
+
+
+def render_variant(actuation: str, digest: str | None = None) -> dict[str, str]:
+    """Sources of one actuation scheme, ``{relative path: text}``, under ``{actuation}/``."""
+    spec = build_spec(actuation)
+    code = straight_line(spec)
+    env = _environment()
+    context = {
+        "spec": spec,
+        "source_hash": digest or source_hash(),
+        "ops_before": code.ops_before,
+        "ops_after": code.ops_after,
+        "assignments": [(str(lhs), numpy_code(rhs)) for lhs, rhs in code.assignments],
+        "outputs": [(k, numpy_code(rhs)) for k, (_, rhs) in enumerate(code.outputs)],
+    }
+    return {
+        f"{actuation}/__init__.py": env.get_template("variant_init.py.jinja").render(context),
+        f"{actuation}/rpr3_numpy.py": env.get_template("numpy_module.py.jinja").render(context),
+    }
+
+
+def render(actuations: Iterable[str] = ACTUATIONS) -> dict[str, str]:
+    """Every generated file for the given actuation schemes, ``{relative path: text}``."""
+    digest = source_hash()
+    files = {
+        "__init__.py": _environment()
+        .get_template("package_init.py.jinja")
+        .render({"source_hash": digest, "actuations": ACTUATIONS})
+    }
+    for actuation in actuations:
+        files.update(render_variant(actuation, digest))
+    return dict(sorted(files.items()))
+
+
+def stale_files(out_dir: Path, files: dict[str, str]) -> list[str]:
+    """Relative paths whose content on disk differs from ``files`` (or that are missing)."""
+    stale = []
+    for rel, text in files.items():
+        path = out_dir / rel
+        if not path.is_file() or path.read_bytes() != text.encode():
+            stale.append(rel)
+    return stale
+
+
+def write_files(out_dir: Path, files: dict[str, str]) -> list[str]:
+    """Write ``files`` under ``out_dir``; return the paths that changed.
+
+    Every file is first written to a temporary file beside its target; only when all are written
+    are they renamed into place, so an error leaves the previous sources as they were.
+    """
+    changed = stale_files(out_dir, files)
+    staged: list[tuple[str, Path]] = []
+    try:
+        for rel in changed:
+            target = out_dir / rel
+            target.parent.mkdir(parents=True, exist_ok=True)
+            fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", dir=target.parent)
+            with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as handle:
+                handle.write(files[rel])
+            staged.append((rel, Path(tmp)))
+        for rel, tmp in staged:
+            os.replace(tmp, out_dir / rel)
+    except BaseException:
+        for _, tmp in staged:
+            tmp.unlink(missing_ok=True)
+        raise
+    return changed
+
+
+def default_out_dir() -> Path | None:
+    """``generated/`` beside ``derive/`` in a source checkout, or None when there is none."""
+    out = PACKAGE_DIR.parent / "generated"
+    return out if (out / "__init__.py").is_file() else None

@@ -1,0 +1,116 @@
+"""The one source of truth for each generated function: ordered inputs, outputs, docstring.
+
+The NumPy module, the C header and source, their name tables and the documentation are all
+rendered from a :class:`FunctionSpec`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cache
+
+import sympy as sp
+from rpr3gen_derive import symbols as syms
+from rpr3gen_derive.dynamics import leg_wrenches
+from rpr3gen_derive.kinematics import leg_kinematics, platform_rotation
+from rpr3gen_derive.symbols import LEGS, PARAM_NAMES, Program
+from rpr3gen_derive.virtual_work import joint_loads
+
+ACTUATIONS: tuple[str, ...] = ("revolute", "prismatic")
+
+
+@dataclass(frozen=True)
+class OutputFamily:
+    """One output of conventions.md, for each of the three legs."""
+
+    name: str
+    unit: str
+    meaning: str
+
+
+OUTPUT_FAMILIES: tuple[OutputFamily, ...] = (
+    OutputFamily("phi10", "rad", "cylinder rotation about z0 from the central configuration"),
+    OutputFamily("lambda21", "m", "piston displacement from the central configuration"),
+    OutputFamily("phi32", "rad", "platform rotation relative to the leg, phi - phi10"),
+    OutputFamily("omega10", "rad/s", "d(phi10)/dt"),
+    OutputFamily("v21", "m/s", "d(lambda21)/dt"),
+    OutputFamily("omega32", "rad/s", "d(phi32)/dt"),
+    OutputFamily("eps10", "rad/s^2", "d2(phi10)/dt2"),
+    OutputFamily("gamma21", "m/s^2", "d2(lambda21)/dt2"),
+    OutputFamily("eps32", "rad/s^2", "d2(phi32)/dt2"),
+    OutputFamily("m10", "N m", "torque of the base on the cylinder at A1 about +z0 (motor)"),
+    OutputFamily("f10x", "N", "force of the base on the cylinder at A1, along x0"),
+    OutputFamily("f10y", "N", "force of the base on the cylinder at A1, along y0"),
+    OutputFamily("f21y", "N", "force of the cylinder on the piston, along y2 = n"),
+    OutputFamily("f21z", "N", "force of the cylinder on the piston, along z2 = e (actuator)"),
+    OutputFamily("m21", "N m", "moment of the cylinder on the piston about A2, along x2 = -z0"),
+    OutputFamily("f32y", "N", "force of the piston on the platform at A3, along y2 = n"),
+    OutputFamily("f32z", "N", "force of the piston on the platform at A3, along z2 = e"),
+)
+
+OUTPUT_NAMES: tuple[str, ...] = tuple(f"{f.name}_{leg}" for f in OUTPUT_FAMILIES for leg in LEGS)
+
+
+@dataclass(frozen=True)
+class FunctionSpec:
+    """A generated function: ``outputs = f(params, q, qd, qdd)``, as a program of assignments."""
+
+    name: str
+    actuation: str
+    param_names: tuple[str, ...]
+    inputs: tuple[tuple[str, tuple[sp.Symbol, ...]], ...]  # ("q", (x, y, phi)), ...
+    program: Program
+    outputs: tuple[tuple[str, sp.Expr], ...]  # (name, expression in program symbols)
+    docstring: str
+
+    @property
+    def output_names(self) -> tuple[str, ...]:
+        return tuple(name for name, _ in self.outputs)
+
+
+def derive(actuation: str) -> tuple[Program, dict[str, sp.Expr]]:
+    """Run the paper's algorithm (steps 1-9) symbolically; return the program and outputs."""
+    if actuation not in ACTUATIONS:
+        raise ValueError(f"actuation must be one of {ACTUATIONS}, got {actuation!r}")
+    prog = Program()
+    cos_phi, sin_phi = platform_rotation(prog)
+    kinematics = {leg: leg_kinematics(prog, leg, cos_phi, sin_phi) for leg in LEGS}
+    wrenches = {
+        leg: leg_wrenches(prog, kinematics[leg], carries_platform=(leg == LEGS[0])) for leg in LEGS
+    }
+    loads = joint_loads(prog, actuation, kinematics, wrenches)
+    values: dict[str, sp.Expr] = {}
+    for leg, kin in kinematics.items():
+        for name in ("phi10", "lambda21", "phi32", "omega10", "v21", "omega32"):
+            values[f"{name}_{leg}"] = getattr(kin, name)
+        for name in ("eps10", "gamma21", "eps32"):
+            values[f"{name}_{leg}"] = getattr(kin, name)
+    values.update(loads)
+    for name in OUTPUT_NAMES:  # the load of the free joint: m10 or f21z, identically zero
+        values.setdefault(name, sp.Integer(0))
+    return prog, {name: values[name] for name in OUTPUT_NAMES}
+
+
+@cache
+def build_spec(actuation: str) -> FunctionSpec:
+    """The spec of ``rpr3_inverse_dynamics`` for one actuation scheme."""
+    prog, outputs = derive(actuation)
+    actuated = "m10 at A1 (f21z = 0)" if actuation == "revolute" else "f21z at A2 (m10 = 0)"
+    doc = (
+        f"Inverse dynamics of the 3-RPR planar parallel robot, {actuation} actuation: "
+        f"actuator load {actuated}. Leg kinematics (eqs. 5, 6, 9) and every joint load "
+        "(eqs. 12-17) from the platform pose q = (x, y, phi), its velocity qd and acceleration qdd."
+    )
+    return FunctionSpec(
+        name="rpr3_inverse_dynamics",
+        actuation=actuation,
+        param_names=PARAM_NAMES,
+        inputs=(
+            ("q", tuple(syms.q)),
+            ("qd", tuple(syms.qd)),
+            ("qdd", tuple(syms.qdd)),
+        ),
+        program=prog,
+        outputs=tuple(outputs.items()),
+        docstring=doc,
+    )

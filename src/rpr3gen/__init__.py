@@ -1,0 +1,32 @@
+"""rpr3gen: inverse dynamics of the 3-RPR planar parallel robot (S. Staicu), from generated code.
+
+>>> import rpr3gen
+>>> model = rpr3gen.load_model()                   # the paper's robot
+>>> traj = rpr3gen.paper_trajectory("rotation")    # eq. (3)
+>>> out = rpr3gen.inverse_dynamics(model, traj.q, traj.qd, traj.qdd)
+>>> out["m10_A"].shape
+(301,)
+
+The runtime imports numpy (and matplotlib for figures) only; regeneration lives in the package
+``rpr3gen_derive`` (folder ``derive/``) and writes ``rpr3gen_generated`` (folder ``generated/``).
+"""
+
+from rpr3gen.backends import BACKENDS, OUTPUT_NAMES, inverse_dynamics
+from rpr3gen.errors import ModelError, Rpr3genError, TrajectoryError
+from rpr3gen.model import PARAM_NAMES, Model, load_model
+from rpr3gen.trajectory import Trajectory, paper_trajectory, read_trajectory_csv
+
+__all__ = [
+    "BACKENDS",
+    "OUTPUT_NAMES",
+    "PARAM_NAMES",
+    "Model",
+    "ModelError",
+    "Rpr3genError",
+    "Trajectory",
+    "TrajectoryError",
+    "inverse_dynamics",
+    "load_model",
+    "paper_trajectory",
+    "read_trajectory_csv",
+]

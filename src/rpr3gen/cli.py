@@ -1,0 +1,193 @@
+"""The ``rpr3gen`` command: ``simulate``, ``paper`` (the paper's two examples) and ``generate``.
+
+Every failure is one line on stderr (``rpr3gen: error: ...``) and exit status 2; ``--debug``
+shows the traceback instead. Output files are written atomically.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+
+from rpr3gen.backends import BACKENDS, OUTPUT_NAMES, inverse_dynamics
+from rpr3gen.errors import Rpr3genError
+from rpr3gen.model import Model, load_model
+from rpr3gen.trajectory import PAPER_TRAJECTORIES, Trajectory, paper_trajectory, read_trajectory_csv
+
+EXIT_ERROR = 2
+
+
+def _parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="rpr3gen",
+        description="Inverse dynamics of the 3-RPR planar parallel robot (Staicu), "
+        "from generated code.",
+    )
+    parser.add_argument("--debug", action="store_true", help="show tracebacks on errors")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+
+    sim = sub.add_parser("simulate", help="evaluate the inverse dynamics over a trajectory")
+    sim.add_argument("--model", metavar="FILE", help="model TOML file (default: the paper's)")
+    sim.add_argument(
+        "--trajectory",
+        default="rotation",
+        metavar="NAME|FILE.csv",
+        help="'rotation' or 'rectilinear' (paper eq. 3) or a trajectory CSV (default: rotation)",
+    )
+    sim.add_argument("--samples", type=int, default=301, help="samples of a paper trajectory")
+    sim.add_argument("--duration", type=float, default=3.0, help="duration of a paper trajectory")
+    sim.add_argument("--backend", choices=BACKENDS, default="numpy")
+    sim.add_argument("--out", metavar="FILE.csv", help="write every output as CSV")
+    sim.add_argument("--plots", metavar="DIR", help="write the paper's figures as PNG")
+
+    paper = sub.add_parser("paper", help="run the paper's two examples: CSV and figures")
+    paper.add_argument("--out", default="results", metavar="DIR", help="default: ./results")
+    paper.add_argument("--backend", choices=BACKENDS, default="numpy")
+
+    gen = sub.add_parser("generate", help="derive and write the generated sources")
+    gen.add_argument("--model", metavar="FILE", help="generate only this model's actuation")
+    gen.add_argument("--out", metavar="DIR", help="default: the source tree's generated/")
+    gen.add_argument(
+        "--check", action="store_true", help="write nothing; fail if the sources are stale"
+    )
+    return parser
+
+
+def _trajectory(args: argparse.Namespace) -> tuple[str, Trajectory]:
+    if args.trajectory in PAPER_TRAJECTORIES:
+        return args.trajectory, paper_trajectory(args.trajectory, args.samples, args.duration)
+    path = Path(args.trajectory)
+    if path.suffix.lower() != ".csv" and not path.exists():
+        names = ", ".join(PAPER_TRAJECTORIES)
+        raise Rpr3genError(f"--trajectory: {args.trajectory!r} is neither {names} nor a CSV file")
+    return path.stem, read_trajectory_csv(path)
+
+
+def _check_finite(traj: Trajectory, out: dict[str, np.ndarray]) -> None:
+    block = np.vstack([out[name] for name in OUTPUT_NAMES])
+    bad = ~np.isfinite(block).all(axis=0)
+    if bad.any():
+        first = int(np.argmax(bad))
+        raise Rpr3genError(
+            f"singular or degenerate pose at t = {traj.t[first]:.6g} s (sample {first + 1}): "
+            f"the outputs are not finite"
+        )
+
+
+def simulate(
+    model: Model,
+    name: str,
+    traj: Trajectory,
+    backend: str,
+    out_csv: str | None,
+    plots_dir: str | None,
+) -> dict[str, np.ndarray]:
+    """Evaluate, check, and write the CSV and figures of one trajectory."""
+    from rpr3gen.atomic import write_results_csv
+
+    out = inverse_dynamics(model, traj.q, traj.qd, traj.qdd, backend=backend)
+    _check_finite(traj, out)
+    if out_csv:
+        Path(out_csv).parent.mkdir(parents=True, exist_ok=True)
+        write_results_csv(out_csv, traj.t, traj.q, out, OUTPUT_NAMES)
+    if plots_dir:
+        from rpr3gen.plots import plot_families
+
+        plot_families(
+            traj.t,
+            out,
+            plots_dir,
+            prefix=name,
+            title=f"{name} ({model.name})",
+            actuation=model.actuation,
+        )
+    return out
+
+
+def _summary(name: str, model: Model, traj: Trajectory, out: dict[str, np.ndarray]) -> str:
+    lines = [f"{name}: {len(traj.t)} samples over {traj.t[-1] - traj.t[0]:g} s, model {model.name}"]
+    lines.append(f"  {'peak |value|':<12} {'leg A':>12} {'leg B':>12} {'leg C':>12}")
+    for family in ("m10", "f21z", "f10x", "f10y", "f21y", "m21", "f32y", "f32z"):
+        peaks = [float(np.max(np.abs(out[f"{family}_{leg}"]))) for leg in "ABC"]
+        lines.append(f"  {family:<12} " + " ".join(f"{p:12.5g}" for p in peaks))
+    return "\n".join(lines)
+
+
+def _cmd_simulate(args: argparse.Namespace) -> int:
+    model = load_model(args.model)
+    name, traj = _trajectory(args)
+    out = simulate(model, name, traj, args.backend, args.out, args.plots)
+    print(_summary(name, model, traj, out))
+    return 0
+
+
+def _cmd_paper(args: argparse.Namespace) -> int:
+    model = load_model()
+    root = Path(args.out)
+    for name in PAPER_TRAJECTORIES:
+        traj = paper_trajectory(name)
+        out = simulate(
+            model, name, traj, args.backend, str(root / f"{name}.csv"), str(root / "figures")
+        )
+        print(_summary(name, model, traj, out))
+    print(f"wrote {root / '*.csv'} and {root / 'figures'}/*.png")
+    return 0
+
+
+def _cmd_generate(args: argparse.Namespace) -> int:
+    try:
+        from rpr3gen_derive import render
+    except ImportError as exc:
+        raise Rpr3genError(
+            f"regeneration needs sympy and jinja2 ({exc.name} is missing): "
+            "pip install 'rpr3gen[derive]'"
+        ) from exc
+    actuations = render.ACTUATIONS
+    if args.model:
+        actuations = (load_model(args.model).actuation,)
+    out_dir = Path(args.out) if args.out else render.default_out_dir()
+    if out_dir is None:
+        raise Rpr3genError("no source tree's generated/ folder here; name one with --out DIR")
+    files = render.render(actuations)
+    if args.check:
+        stale = render.stale_files(out_dir, files)
+        if stale:
+            raise Rpr3genError(
+                f"{out_dir}: stale or edited generated files: {', '.join(stale)}; "
+                "run `rpr3gen generate`"
+            )
+        print(f"{out_dir}: {len(files)} generated files up to date")
+        return 0
+    changed = render.write_files(out_dir, files)
+    print(f"{out_dir}: {len(changed)} of {len(files)} files changed")
+    return 0
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of the ``rpr3gen`` command; returns the exit status."""
+    args = _parser().parse_args(argv)
+    commands = {"simulate": _cmd_simulate, "paper": _cmd_paper, "generate": _cmd_generate}
+    try:
+        return commands[args.command](args)
+    except (Rpr3genError, OSError) as exc:
+        if args.debug:
+            raise
+        message = str(exc) if isinstance(exc, Rpr3genError) else _os_message(exc)
+        print(f"rpr3gen: error: {message}", file=sys.stderr)
+        return EXIT_ERROR
+    except KeyboardInterrupt:
+        print("rpr3gen: interrupted", file=sys.stderr)
+        return 130
+
+
+def _os_message(exc: OSError) -> str:
+    where = f"{exc.filename}: " if exc.filename else ""
+    return f"{where}{exc.strerror or exc}"
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,127 @@
+"""The `rpr3gen` command end to end: simulate, paper, and its errors."""
+
+from __future__ import annotations
+
+import csv
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import rpr3gen
+from rpr3gen.cli import main
+from rpr3gen.trajectory import Trajectory, write_trajectory_csv
+
+HEADER = ["t", "x", "y", "phi", *rpr3gen.OUTPUT_NAMES]
+
+
+def _read(path: Path) -> tuple[list[str], np.ndarray]:
+    with path.open(newline="") as handle:
+        rows = list(csv.reader(handle))
+    return rows[0], np.array(rows[1:], dtype=float)
+
+
+@pytest.mark.parametrize("name", ["rotation", "rectilinear"])
+def test_simulate_paper_trajectory_writes_csv_and_figures(name: str, tmp_path: Path) -> None:
+    out, figs = tmp_path / "r.csv", tmp_path / "figs"
+    assert main(["simulate", "--trajectory", name, "--out", str(out), "--plots", str(figs)]) == 0
+    header, table = _read(out)
+    assert header == HEADER
+    assert table.shape == (301, len(HEADER))
+    traj = rpr3gen.paper_trajectory(name)
+    expected = rpr3gen.inverse_dynamics(rpr3gen.load_model(), traj.q, traj.qd, traj.qdd)
+    np.testing.assert_array_equal(table[:, 0], traj.t)
+    for k, column in enumerate(rpr3gen.OUTPUT_NAMES, start=4):
+        np.testing.assert_array_equal(table[:, k], expected[column], err_msg=column)
+    pngs = sorted(p.name for p in figs.glob("*.png"))
+    for family in ("f10x", "f10y", "f21y", "m21", "f32y", "f32z", "m10"):
+        assert f"{name}_{family}.png" in pngs
+
+
+def test_simulate_model_file_and_trajectory_file(tmp_path: Path, repo_root: Path) -> None:
+    model = tmp_path / "slide.toml"
+    text = (repo_root / "models" / "paper.toml").read_text()
+    model.write_text(text.replace('actuation = "revolute"', 'actuation = "prismatic"'))
+    t = np.linspace(0.0, 1.0, 50)
+    w = 2 * np.pi
+    q = np.stack([0.02 * np.sin(w * t), 0.01 * np.cos(w * t), 0.1 * np.sin(w * t)], axis=1)
+    qd = np.stack([0.02 * w * np.cos(w * t), -0.01 * w * np.sin(w * t), 0.1 * w * np.cos(w * t)], 1)
+    qdd = -(w**2) * q
+    motion = tmp_path / "motion.csv"
+    write_trajectory_csv(motion, Trajectory(t, q, qd, qdd))
+    out, figs = tmp_path / "out.csv", tmp_path / "figs"
+    argv = ["simulate", "--model", str(model), "--trajectory", str(motion), "--out", str(out)]
+    assert main([*argv, "--plots", str(figs)]) == 0
+    header, table = _read(out)
+    assert header == HEADER
+    assert table.shape == (50, len(HEADER))
+    assert np.all(table[:, HEADER.index("m10_A")] == 0.0)  # passive base joint
+    assert np.any(table[:, HEADER.index("f21z_A")] != 0.0)  # the actuated slide
+    assert (figs / "motion_f21z.png").is_file()
+
+
+def test_paper_command_runs_both_examples(tmp_path: Path) -> None:
+    assert main(["paper", "--out", str(tmp_path)]) == 0
+    for name in ("rotation", "rectilinear"):
+        header, _ = _read(tmp_path / f"{name}.csv")
+        assert header == HEADER
+        assert (tmp_path / "figures" / f"{name}_f32z.png").is_file()
+
+
+def _cli(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        [sys.executable, "-m", "rpr3gen.cli", *args], capture_output=True, text=True, cwd=cwd
+    )
+
+
+@pytest.mark.parametrize(
+    ("args", "expected"),
+    [
+        (["simulate", "--model", "missing.toml"], "missing.toml"),
+        (["simulate", "--trajectory", "nowhere.csv"], "nowhere.csv"),
+        (["simulate", "--trajectory", "spiral"], "spiral"),
+        (["simulate", "--samples", "1"], "samples"),
+    ],
+)
+def test_errors_are_one_line_without_traceback(
+    args: list[str], expected: str, tmp_path: Path
+) -> None:
+    result = _cli(*args, cwd=tmp_path)
+    assert result.returncode == 2
+    assert result.stderr.count("\n") == 1, result.stderr
+    assert expected in result.stderr
+    assert "Traceback" not in result.stderr
+
+
+def test_bad_trajectory_leaves_existing_output_untouched(tmp_path: Path) -> None:
+    out = tmp_path / "keep.csv"
+    out.write_text("precious\n")
+    bad = tmp_path / "bad.csv"
+    bad.write_text(
+        "t,x,y,phi,dx,dy,dphi,ddx,ddy,ddphi\n0,0,0,0,0,0,0,0,0,0\n1,0,0,nan,0,0,0,0,0,0\n"
+    )
+    result = _cli("simulate", "--trajectory", str(bad), "--out", str(out), cwd=tmp_path)
+    assert result.returncode == 2
+    assert "phi" in result.stderr
+    assert out.read_text() == "precious\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.csv", "keep.csv"]
+
+
+def test_singular_pose_is_refused_with_its_time(tmp_path: Path) -> None:
+    # The last sample puts the platform joint B3 on the base pivot B1: leg B has zero length.
+    model = rpr3gen.load_model()
+    p = model.params
+    x = p["xB1"] - p["xB3"]
+    y = p["yB1"] - p["yB3"]
+    t = np.array([0.0, 0.5, 1.0])
+    q = np.array([[0.0, 0.0, 0.0], [x / 2, y / 2, 0.0], [x, y, 0.0]])
+    z = np.zeros_like(q)
+    motion = tmp_path / "through.csv"
+    write_trajectory_csv(motion, Trajectory(t, q, z, z))
+    out = tmp_path / "o.csv"
+    result = _cli("simulate", "--trajectory", str(motion), "--out", str(out), cwd=tmp_path)
+    assert result.returncode == 2
+    assert "t = 1 s" in result.stderr
+    assert not out.exists()

@@ -1,0 +1,114 @@
+"""Regeneration: committed sources are current, output is deterministic and self-describing."""
+
+from __future__ import annotations
+
+import os
+import re
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from rpr3gen.cli import main
+
+render = __import__("rpr3gen_derive.render", fromlist=["render"])
+
+
+def test_committed_generated_tree_is_current(
+    repo_root: Path, capsys: pytest.CaptureFixture
+) -> None:
+    assert main(["generate", "--check", "--out", str(repo_root / "generated")]) == 0
+    assert "up to date" in capsys.readouterr().out
+
+
+def test_check_detects_hand_edit(
+    repo_root: Path, tmp_path: Path, capsys: pytest.CaptureFixture
+) -> None:
+    copy = tmp_path / "generated"
+    shutil.copytree(repo_root / "generated", copy)
+    target = copy / "revolute" / "rpr3_numpy.py"
+    target.write_text(target.read_text().replace("out[0] =", "out[0] = 1.0 +", 1))
+    before = target.read_bytes()
+    assert main(["generate", "--check", "--out", str(copy)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1
+    assert "revolute/rpr3_numpy.py" in err
+    assert target.read_bytes() == before  # --check writes nothing
+
+
+def test_check_detects_missing_file(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
+    assert main(["generate", "--check", "--out", str(tmp_path / "nothing")]) == 2
+    assert "stale" in capsys.readouterr().err
+
+
+def test_generate_then_check_round_trip(tmp_path: Path) -> None:
+    out = tmp_path / "gen"
+    assert main(["generate", "--out", str(out)]) == 0
+    assert main(["generate", "--check", "--out", str(out)]) == 0
+    assert sorted(p.relative_to(out).as_posix() for p in out.rglob("*") if p.is_file()) == sorted(
+        render.render()
+    )
+
+
+def test_generate_for_a_model_writes_its_variant_only(tmp_path: Path, repo_root: Path) -> None:
+    model = tmp_path / "prismatic.toml"
+    text = (repo_root / "models" / "paper.toml").read_text()
+    model.write_text(text.replace('actuation = "revolute"', 'actuation = "prismatic"'))
+    out = tmp_path / "gen"
+    assert main(["generate", "--model", str(model), "--out", str(out)]) == 0
+    assert (out / "prismatic" / "rpr3_numpy.py").is_file()
+    assert not (out / "revolute").exists()
+
+
+def _render_in_subprocess(out: Path, seed: str) -> None:
+    env = dict(os.environ, PYTHONHASHSEED=seed)
+    code = (
+        "import sys; from rpr3gen.cli import main; "
+        "sys.exit(main(['generate', '--out', sys.argv[1]]))"
+    )
+    subprocess.run([sys.executable, "-c", code, str(out)], check=True, env=env, capture_output=True)
+
+
+def test_output_is_identical_across_hash_seeds(tmp_path: Path) -> None:
+    first, second = tmp_path / "a", tmp_path / "b"
+    _render_in_subprocess(first, "1")
+    _render_in_subprocess(second, "4242")
+    files = sorted(p.relative_to(first) for p in first.rglob("*") if p.is_file())
+    assert files
+    for rel in files:
+        assert (first / rel).read_bytes() == (second / rel).read_bytes(), rel
+
+
+def test_headers_carry_source_hash_and_nothing_volatile(repo_root: Path) -> None:
+    digest = render.source_hash()
+    import jinja2
+    import sympy
+
+    for path in sorted((repo_root / "generated").rglob("*.py")):
+        text = path.read_text()
+        head = text.splitlines()[:3]
+        assert "do not edit" in head[0], path
+        assert head[1] == f"# Source hash: {digest}", path
+        assert not re.search(r"\b20\d\d-\d\d-\d\d\b", text), path
+        assert str(repo_root) not in text, path
+        assert sympy.__version__ not in head[2]
+        assert jinja2.__version__ not in head[2]
+
+
+def test_cse_reduces_the_operation_count(repo_root: Path) -> None:
+    for actuation in ("revolute", "prismatic"):
+        head = (repo_root / "generated" / actuation / "rpr3_numpy.py").read_text().splitlines()[2]
+        before, after = map(int, re.findall(r"(\d+) (?:before|after)", head))
+        assert after < before
+
+
+def test_source_hash_follows_the_sources(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    copy = tmp_path / "derive"
+    shutil.copytree(render.PACKAGE_DIR, copy, ignore=shutil.ignore_patterns("__pycache__"))
+    monkeypatch.setattr(render, "PACKAGE_DIR", copy)
+    monkeypatch.setattr(render, "TEMPLATE_DIR", copy / "templates")
+    original = render.source_hash()
+    (copy / "frames.py").write_text((copy / "frames.py").read_text() + "\n# edit\n")
+    assert render.source_hash() != original
