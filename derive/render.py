@@ -14,8 +14,8 @@ from pathlib import Path
 
 import jinja2
 from rpr3gen_derive.cse import straight_line
-from rpr3gen_derive.printers import numpy_code
-from rpr3gen_derive.specs import ACTUATIONS, build_spec
+from rpr3gen_derive.printers import c_code, numpy_code
+from rpr3gen_derive.specs import ACTUATIONS, OUTPUT_DOCS, PARAM_DOCS, build_spec
 
 PACKAGE_DIR = Path(__file__).resolve().parent
 TEMPLATE_DIR = PACKAGE_DIR / "templates"
@@ -48,18 +48,37 @@ def render_variant(actuation: str, digest: str | None = None) -> dict[str, str]:
     """Sources of one actuation scheme, ``{relative path: text}``, under ``{actuation}/``."""
     spec = build_spec(actuation)
     code = straight_line(spec)
+    used = set().union(*(rhs.free_symbols for _, rhs in code.assignments + code.outputs))
+    used_names = {str(sym) for sym in used}
     env = _environment()
     context = {
         "spec": spec,
         "source_hash": digest or source_hash(),
         "ops_before": code.ops_before,
         "ops_after": code.ops_after,
+        "used_params": [(k, n) for k, n in enumerate(spec.param_names) if n in used_names],
+        "used_inputs": [
+            (group, k, str(sym))
+            for group, symbols in spec.inputs
+            for k, sym in enumerate(symbols)
+            if str(sym) in used_names
+        ],
         "assignments": [(str(lhs), numpy_code(rhs)) for lhs, rhs in code.assignments],
         "outputs": [(k, numpy_code(rhs)) for k, (_, rhs) in enumerate(code.outputs)],
+        "c_assignments": [(str(lhs), c_code(rhs)) for lhs, rhs in code.assignments],
+        "c_outputs": [(k, c_code(rhs)) for k, (_, rhs) in enumerate(code.outputs)],
+        "params_doc": PARAM_DOCS,
+        "outputs_doc": OUTPUT_DOCS,
+    }
+    templates = {
+        "__init__.py": "variant_init.py.jinja",
+        "rpr3_numpy.py": "numpy_module.py.jinja",
+        "rpr3.h": "c_header.h.jinja",
+        "rpr3.c": "c_source.c.jinja",
     }
     return {
-        f"{actuation}/__init__.py": env.get_template("variant_init.py.jinja").render(context),
-        f"{actuation}/rpr3_numpy.py": env.get_template("numpy_module.py.jinja").render(context),
+        f"{actuation}/{name}": env.get_template(template).render(context)
+        for name, template in templates.items()
     }
 
 

@@ -51,6 +51,43 @@ OUTPUT_FAMILIES: tuple[OutputFamily, ...] = (
 OUTPUT_NAMES: tuple[str, ...] = tuple(f"{f.name}_{leg}" for f in OUTPUT_FAMILIES for leg in LEGS)
 
 
+def _param_doc(name: str) -> tuple[str, str]:
+    """Unit and meaning of a model parameter (interfaces.md)."""
+    fixed = {
+        "l0": ("m", "|A1A2| = l0 + lambda21"),
+        "l2": ("m", "|A2A3|"),
+        "c1": ("m", "cylinder centre of mass at A1 + c1 e"),
+        "c2": ("m", "piston centre of mass at A2 + c2 e"),
+        "m1": ("kg", "cylinder mass"),
+        "m2": ("kg", "piston mass"),
+        "m3": ("kg", "platform mass"),
+        "J1": ("kg m^2", "cylinder inertia about its centre of mass, axis z"),
+        "J2": ("kg m^2", "piston inertia about its centre of mass, axis z"),
+        "J3": ("kg m^2", "platform inertia about G, axis z"),
+        "gx": ("m/s^2", "gravity, world x0"),
+        "gy": ("m/s^2", "gravity, world y0 (up)"),
+        "fx": ("N", "payload force on the platform at G, x0"),
+        "fy": ("N", "payload force on the platform at G, y0"),
+        "mz": ("N m", "payload moment on the platform, about z0"),
+    }
+    if name in fixed:
+        return fixed[name]
+    if name.startswith("alpha_"):
+        return "rad", f"leg {name[-1]} angle where phi10 = 0"
+    axis, leg, point = name[0], name[1], name[2]
+    if point == "1":
+        return "m", f"base pivot {leg}1, world {axis}0"
+    return "m", f"platform joint {leg}3, platform frame {axis}G"
+
+
+PARAM_DOCS: tuple[tuple[str, str, str], ...] = tuple(
+    (name, *_param_doc(name)) for name in PARAM_NAMES
+)
+OUTPUT_DOCS: tuple[tuple[str, str, str], ...] = tuple(
+    (f"{f.name}_{leg}", f.unit, f.meaning) for f in OUTPUT_FAMILIES for leg in LEGS
+)
+
+
 @dataclass(frozen=True)
 class FunctionSpec:
     """A generated function: ``outputs = f(params, q, qd, qdd)``, as a program of assignments."""

@@ -126,8 +126,11 @@ def write_paper_symmetric(path: Path, *, actuation: str) -> Path:
     return path
 
 
-def run(model, q, qd, qdd) -> dict[str, np.ndarray]:
-    out = rpr3gen.inverse_dynamics(model, q, qd, qdd, backend="numpy")
+BACKENDS = ("numpy", "c")
+
+
+def run(model, q, qd, qdd, backend: str = "numpy") -> dict[str, np.ndarray]:
+    out = rpr3gen.inverse_dynamics(model, q, qd, qdd, backend=backend)
     expected = {f"{fam}_{leg}" for fam in ne.FAMILIES for leg in ne.LEGS}
     assert set(out) == expected, (
         f"missing {sorted(expected - set(out))}, unexpected {sorted(set(out) - expected)}"
@@ -238,24 +241,26 @@ def test_paper_trajectory_is_eq3(kind):
         np.testing.assert_allclose(np.asarray(got, dtype=float), want, rtol=0, atol=1e-14)
 
 
+@pytest.mark.parametrize("backend", BACKENDS)
 @pytest.mark.parametrize("kind", ["rotation", "rectilinear"])
-def test_paper_trajectories_agree_with_newton_euler(kind):
+def test_paper_trajectories_agree_with_newton_euler(kind, backend):
     model = rpr3gen.load_model()
     traj = rpr3gen.paper_trajectory(kind, samples=301, duration=3.0)
     q, qd, qdd = (np.asarray(a, dtype=float) for a in (traj.q, traj.qd, traj.qdd))
-    out = run(model, q, qd, qdd)
+    out = run(model, q, qd, qdd, backend)
     ref = ne.solve(ne.paper_params(), "revolute", q, qd, qdd)
-    assert_agree(out, ref, f"paper robot, {kind}")
+    assert_agree(out, ref, f"paper robot, {kind}, {backend}")
 
 
+@pytest.mark.parametrize("backend", BACKENDS)
 @pytest.mark.parametrize("kind", ["rotation", "rectilinear"])
-def test_paper_prismatic_agrees_with_newton_euler(kind, tmp_path):
+def test_paper_prismatic_agrees_with_newton_euler(kind, backend, tmp_path):
     model = rpr3gen.load_model(write_paper_symmetric(tmp_path / "p.toml", actuation="prismatic"))
     assert model.actuation == "prismatic"
     _, q, qd, qdd = ne.paper_motion(kind, 301, 3.0)
-    out = run(model, q, qd, qdd)
+    out = run(model, q, qd, qdd, backend)
     ref = ne.solve(ne.paper_params(), "prismatic", q, qd, qdd)
-    assert_agree(out, ref, f"paper robot, prismatic, {kind}")
+    assert_agree(out, ref, f"paper robot, prismatic, {kind}, {backend}")
 
 
 @pytest.mark.parametrize("actuation", ne.ACTUATIONS)
@@ -321,6 +326,14 @@ def test_random_models_agree_with_newton_euler(seed, random_run):
     p, actuation, _, q, qd, qdd, out = random_run(seed)
     ref = ne.solve(p, actuation, q, qd, qdd)
     assert_agree(out, ref, f"random model seed {seed} ({actuation})")
+
+
+@pytest.mark.parametrize("seed", range(N_RANDOM))
+def test_random_models_c_backend_agrees_with_newton_euler(seed, random_run):
+    p, actuation, model, q, qd, qdd, _ = random_run(seed)
+    out = run(model, q, qd, qdd, "c")
+    ref = ne.solve(p, actuation, q, qd, qdd)
+    assert_agree(out, ref, f"random model seed {seed} ({actuation}), c backend")
 
 
 @pytest.mark.parametrize("seed", range(N_RANDOM))

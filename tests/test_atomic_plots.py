@@ -218,9 +218,11 @@ def test_plots_are_reproducible(tmp_path: Path) -> None:
 
 def test_titles_and_labels() -> None:
     revolute = plotted_families("revolute")
-    assert revolute[0].title("rotation") == "Joint forces f10x (paper fig. 3/9) — rotation"
-    assert revolute[3].title("rectilinear") == "Joint torques m21 (paper fig. 6/12) — rectilinear"
-    assert revolute[5].title("") == "Joint forces f32z (paper fig. 8/14)"
+    assert revolute[0].title("rotation") == "Joint forces f10x (paper fig. 3) — rotation"
+    assert revolute[3].title("rectilinear (paper)") == (
+        "Joint torques m21 (paper fig. 12) — rectilinear (paper)"
+    )
+    assert revolute[5].title("motion") == "Joint forces f32z (cf. paper figs 8, 14) — motion"
     assert [(s.family, s.unit) for s in revolute[6:]] == [
         ("m10", "N·m"),
         ("phi10", "rad"),

@@ -14,6 +14,7 @@ The runtime imports numpy (and matplotlib for figures) only; regeneration lives 
 from rpr3gen.backends import BACKENDS, OUTPUT_NAMES, inverse_dynamics
 from rpr3gen.errors import ModelError, Rpr3genError, TrajectoryError
 from rpr3gen.model import PARAM_NAMES, Model, load_model
+from rpr3gen.sample import SampleEvaluator
 from rpr3gen.trajectory import Trajectory, paper_trajectory, read_trajectory_csv
 
 __all__ = [
@@ -23,6 +24,7 @@ __all__ = [
     "Model",
     "ModelError",
     "Rpr3genError",
+    "SampleEvaluator",
     "Trajectory",
     "TrajectoryError",
     "inverse_dynamics",

@@ -7,7 +7,6 @@ sub-package per actuation scheme; this module only shapes arrays and picks the v
 from __future__ import annotations
 
 import importlib
-from collections.abc import Callable
 from types import ModuleType
 
 import numpy as np
@@ -16,7 +15,7 @@ from numpy.typing import ArrayLike
 from rpr3gen.errors import Rpr3genError
 from rpr3gen.model import Model
 
-BACKENDS: tuple[str, ...] = ("numpy",)
+BACKENDS: tuple[str, ...] = ("numpy", "c")
 
 _FAMILIES = (
     "phi10", "lambda21", "phi32", "omega10", "v21", "omega32", "eps10", "gamma21", "eps32",
@@ -45,10 +44,23 @@ def _samples(name: str, value: ArrayLike) -> np.ndarray:
     return np.ascontiguousarray(array)
 
 
-def _evaluator(model: Model, backend: str) -> tuple[Callable[..., None], tuple[str, ...]]:
+def _evaluate(
+    model: Model, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, backend: str
+) -> np.ndarray:
+    """All outputs as a (NUM_OUTPUTS, n) array; rows of a singular sample are inf or nan."""
     if backend == "numpy":
         module = numpy_module(model.actuation)
-        return module.rpr3_inverse_dynamics, tuple(module.PARAM_NAMES)
+        out = np.empty((len(OUTPUT_NAMES), q.shape[0]))
+        module.rpr3_inverse_dynamics(model.vector(module.PARAM_NAMES), q, qd, qdd, out)
+        return out
+    if backend == "c":
+        from rpr3gen import cbackend
+
+        param_names, output_names = cbackend.names(model.actuation)
+        if output_names != OUTPUT_NAMES:
+            raise Rpr3genError("generated C does not match this runtime; run `rpr3gen generate`")
+        rows, _ = cbackend.batch(model.vector(param_names), q, qd, qdd, model.actuation)
+        return rows.T
     raise Rpr3genError(f"unknown backend {backend!r}; choose one of {', '.join(BACKENDS)}")
 
 
@@ -66,16 +78,16 @@ def inverse_dynamics(
         q: (n, 3) platform pose (x, y, phi) of the centre G, in m, m, rad (eq. 3 or a file).
         qd: (n, 3) velocity (dx, dy, dphi).
         qdd: (n, 3) acceleration (ddx, ddy, ddphi).
-        backend: ``"numpy"``.
+        backend: ``"numpy"`` (generated NumPy) or ``"c"`` (generated C, compiled on first use
+            and cached; see :mod:`rpr3gen.cbackend`).
 
     Returns:
         ``{name: (n,) array}`` for every name of :data:`OUTPUT_NAMES` (conventions.md: loads
-        exerted by body k-1 on body k, SI units). A sample at a singular pose gives inf or nan.
+        exerted by body k-1 on body k, SI units). A sample at a singular pose gives inf or nan
+        (numpy) or nan (c). With ``"c"`` the arrays are strided views of one row-major block.
     """
     q, qd, qdd = _samples("q", q), _samples("qd", qd), _samples("qdd", qdd)
     if not q.shape == qd.shape == qdd.shape:
         raise Rpr3genError(f"q, qd, qdd differ in shape: {q.shape}, {qd.shape}, {qdd.shape}")
-    function, param_names = _evaluator(model, backend)
-    out = np.empty((len(OUTPUT_NAMES), q.shape[0]))
-    function(model.vector(param_names), q, qd, qdd, out)
+    out = _evaluate(model, q, qd, qdd, backend)
     return dict(zip(OUTPUT_NAMES, out, strict=True))

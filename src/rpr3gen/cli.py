@@ -48,6 +48,11 @@ def _parser() -> argparse.ArgumentParser:
     paper.add_argument("--out", default="results", metavar="DIR", help="default: ./results")
     paper.add_argument("--backend", choices=BACKENDS, default="numpy")
 
+    par = sub.add_parser(
+        "params", help="print a model's parameter vector as 'name value' lines (for C users)"
+    )
+    par.add_argument("--model", metavar="FILE", help="model TOML file (default: the paper's)")
+
     gen = sub.add_parser("generate", help="derive and write the generated sources")
     gen.add_argument("--model", metavar="FILE", help="generate only this model's actuation")
     gen.add_argument("--out", metavar="DIR", help="default: the source tree's generated/")
@@ -138,6 +143,13 @@ def _cmd_paper(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_params(args: argparse.Namespace) -> int:
+    model = load_model(args.model)
+    lines = [f"{name} {value:.17g}" for name, value in model.params.items()]
+    print("\n".join(lines))
+    return 0
+
+
 def _cmd_generate(args: argparse.Namespace) -> int:
     try:
         from rpr3gen_derive import render
@@ -170,7 +182,12 @@ def _cmd_generate(args: argparse.Namespace) -> int:
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``rpr3gen`` command; returns the exit status."""
     args = _parser().parse_args(argv)
-    commands = {"simulate": _cmd_simulate, "paper": _cmd_paper, "generate": _cmd_generate}
+    commands = {
+        "simulate": _cmd_simulate,
+        "paper": _cmd_paper,
+        "params": _cmd_params,
+        "generate": _cmd_generate,
+    }
     try:
         return commands[args.command](args)
     except (Rpr3genError, OSError) as exc:

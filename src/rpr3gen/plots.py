@@ -47,10 +47,19 @@ class FamilyPlot:
     paper_figs: str = ""
 
     def title(self, suffix: str) -> str:
-        """Figure title, e.g. ``"Joint forces f10x (paper fig. 3/9) — rotation"``."""
+        """Figure title, e.g. ``"Joint forces f10x (paper fig. 3) — rotation (paper)"``.
+
+        The figure number is the example's own when ``suffix`` names one of the paper's
+        examples (rotation: figs 3-8, rectilinear: figs 9-14), else both are cited.
+        """
         text = f"{self.what} {self.family}"
         if self.paper_figs:
-            text += f" (paper fig. {self.paper_figs})"
+            rotation, rectilinear = self.paper_figs.split("/")
+            example = suffix.split(" ", 1)[0]
+            figs = {"rotation": rotation, "rectilinear": rectilinear}.get(example)
+            text += (
+                f" (paper fig. {figs})" if figs else f" (cf. paper figs {rotation}, {rectilinear})"
+            )
         return f"{text} — {suffix}" if suffix else text
 
 

@@ -1,0 +1,202 @@
+"""The generated C and the `c` backend: agreement, ABI behaviour, build cache, threads."""
+
+from __future__ import annotations
+
+import ctypes
+import shutil
+import subprocess
+import sys
+import threading
+from pathlib import Path
+
+import newton_euler as ne
+import numpy as np
+import pytest
+
+import rpr3gen
+from rpr3gen import cbackend
+from rpr3gen.model import Model
+
+ACTUATIONS = ("revolute", "prismatic")
+T = np.linspace(0.0, 2.0, 201)
+
+
+def _model(params: dict[str, float], actuation: str) -> Model:
+    return Model(name="test", actuation=actuation, params=params, source="<test>")
+
+
+def _cases():
+    for seed in range(12):
+        robot, q, qd, qdd = ne.random_case(seed, T)
+        yield seed, _model(robot["params"], ACTUATIONS[seed % 2]), q, qd, qdd
+    for actuation in ACTUATIONS:
+        for kind in ("rotation", "rectilinear"):
+            _, q, qd, qdd = ne.paper_motion(kind, 301, 3.0)
+            yield kind, _model(ne.paper_params(), actuation), q, qd, qdd
+
+
+@pytest.mark.parametrize("case", list(_cases()), ids=lambda c: f"{c[0]}-{c[1].actuation}")
+def test_c_equals_numpy_to_1e_12(case) -> None:
+    _, model, q, qd, qdd = case
+    a = rpr3gen.inverse_dynamics(model, q, qd, qdd, backend="numpy")
+    b = rpr3gen.inverse_dynamics(model, q, qd, qdd, backend="c")
+    for family in ne.FAMILIES:
+        names = [f"{family}_{leg}" for leg in "ABC"]
+        scale = max(np.max(np.abs(a[n])) for n in names)
+        for n in names:
+            error = np.max(np.abs(a[n] - b[n]))
+            assert error <= 1e-12 * max(scale, 1e-300), (n, error, scale)
+
+
+def _ptr(array: np.ndarray) -> ctypes.c_void_p:
+    return ctypes.c_void_p(array.ctypes.data)
+
+
+@pytest.mark.parametrize("actuation", ACTUATIONS)
+def test_single_and_batch_agree_bit_for_bit(actuation: str) -> None:
+    _, model, q, qd, qdd = next(c for c in _cases() if c[1].actuation == actuation)
+    params = np.ascontiguousarray(model.vector(cbackend.names(actuation)[0]))
+    rows, failed = cbackend.batch(params, q, qd, qdd, actuation)
+    assert failed == 0
+    lib = cbackend.library(actuation)
+    out = np.empty(rows.shape[1])
+    for i in range(len(q)):
+        args = [np.ascontiguousarray(a[i]) for a in (q, qd, qdd)]
+        assert lib.rpr3_inverse_dynamics(_ptr(params), *map(_ptr, args), _ptr(out)) == 0
+        assert out.tobytes() == rows[i].tobytes(), i
+
+
+def _singular_sample(model: Model) -> np.ndarray:
+    p = model.params  # platform joint B3 on the base pivot B1: leg B has zero length
+    return np.array([p["xB1"] - p["xB3"], p["yB1"] - p["yB3"], 0.0])
+
+
+@pytest.mark.parametrize("actuation", ACTUATIONS)
+def test_failure_codes_leave_outputs_untouched(actuation: str) -> None:
+    model = _model(ne.paper_params(), actuation)
+    lib = cbackend.library(actuation)
+    params = np.ascontiguousarray(model.vector(cbackend.names(actuation)[0]))
+    zero = np.zeros(3)
+    out = np.full(len(rpr3gen.OUTPUT_NAMES), 7.0)
+    for bad, code in (
+        (np.array([0.0, np.nan, 0.0]), 1),
+        (np.array([np.inf, 0.0, 0.0]), 1),
+        (_singular_sample(model), 2),
+    ):
+        assert (
+            lib.rpr3_inverse_dynamics(_ptr(params), _ptr(bad), *map(_ptr, (zero, zero, out)))
+            == code
+        )
+        assert np.all(out == 7.0)
+    q = np.array([[0.0, 0.0, 0.0], [0.0, np.nan, 0.0], list(_singular_sample(model)), [0.01, 0, 0]])
+    z = np.zeros_like(q)
+    rows, failed = cbackend.batch(params, q, z, z, actuation)
+    assert failed == 2
+    assert np.isnan(rows[1]).all()
+    assert np.isnan(rows[2]).all()
+    assert np.isfinite(rows[[0, 3]]).all()
+
+
+@pytest.mark.parametrize("actuation", ACTUATIONS)
+def test_generated_c_compiles_without_warnings(
+    actuation: str, repo_root: Path, tmp_path: Path
+) -> None:
+    cc = shutil.which("cc") or shutil.which("gcc")
+    assert cc, "a C compiler is required by the test suite"
+    source = repo_root / "generated" / actuation / "rpr3.c"
+    result = subprocess.run(
+        [cc, "-std=c99", "-O2", "-Wall", "-Wextra", "-pedantic", "-Werror", "-c", str(source),
+         "-o", str(tmp_path / "rpr3.o")],
+        capture_output=True, text=True, check=False,
+    )  # fmt: skip
+    assert result.returncode == 0, result.stderr
+    assert result.stderr == ""
+
+
+def test_generated_c_needs_only_math_and_stddef(repo_root: Path) -> None:
+    for path in sorted((repo_root / "generated").rglob("rpr3.[ch]")):
+        includes = {
+            line.split()[1] for line in path.read_text().splitlines() if line.startswith("#include")
+        }
+        assert includes <= {"<math.h>", "<stddef.h>", '"rpr3.h"'}, (path, includes)
+        assert "malloc" not in path.read_text()
+        assert "static double" not in path.read_text()  # no hidden state
+
+
+def test_threads_get_the_same_results() -> None:
+    model = rpr3gen.load_model()
+    cases = [ne.random_case(seed, T)[1:] for seed in range(4)]
+    expected = [rpr3gen.inverse_dynamics(model, *c, backend="c") for c in cases]
+    results: dict[tuple[int, int], dict] = {}
+
+    def work(thread: int) -> None:
+        for repeat in range(20):
+            k = (thread + repeat) % len(cases)
+            results[(thread, repeat)] = rpr3gen.inverse_dynamics(model, *cases[k], backend="c")
+
+    threads = [threading.Thread(target=work, args=(t,)) for t in range(6)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert len(results) == 120
+    for (thread, repeat), out in results.items():
+        want = expected[(thread + repeat) % len(cases)]
+        for name in rpr3gen.OUTPUT_NAMES:
+            assert out[name].tobytes() == want[name].tobytes()
+
+
+def test_build_is_cached_and_rebuilt_when_the_source_changes(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setenv("RPR3GEN_CACHE_DIR", str(tmp_path))
+    first = cbackend.library_path("revolute")
+    stamp = first.stat().st_mtime_ns
+    assert cbackend.library_path("revolute") == first
+    assert first.stat().st_mtime_ns == stamp  # reused, not rebuilt
+    source, header = cbackend.sources("revolute")
+    monkeypatch.setattr(
+        cbackend, "sources", lambda actuation: (source + b"\n/* changed */\n", header)
+    )
+    second = cbackend.library_path("revolute")
+    assert second != first
+    assert second.is_file()
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted([first.name, second.name])
+
+
+def test_missing_compiler_is_one_clear_line(tmp_path: Path) -> None:
+    env = {"PATH": "/usr/bin:/bin", "CC": "no-such-cc", "RPR3GEN_CACHE_DIR": str(tmp_path)}
+    result = subprocess.run(
+        [sys.executable, "-m", "rpr3gen.cli", "simulate", "--backend", "c"],
+        capture_output=True, text=True, env=env, check=False,
+    )  # fmt: skip
+    assert result.returncode == 2
+    assert result.stderr.count("\n") == 1
+    assert "C compiler" in result.stderr
+    assert "Traceback" not in result.stderr
+
+
+def test_cli_simulate_with_c_backend_matches_numpy(tmp_path: Path) -> None:
+    from rpr3gen.cli import main
+
+    assert main(["simulate", "--backend", "c", "--out", str(tmp_path / "c.csv")]) == 0
+    assert main(["simulate", "--backend", "numpy", "--out", str(tmp_path / "n.csv")]) == 0
+    c = np.loadtxt(tmp_path / "c.csv", delimiter=",", skiprows=1)
+    n = np.loadtxt(tmp_path / "n.csv", delimiter=",", skiprows=1)
+    np.testing.assert_allclose(c, n, rtol=1e-12, atol=1e-12)
+
+
+def test_sample_evaluator_matches_batch() -> None:
+    model = rpr3gen.load_model()
+    traj = rpr3gen.paper_trajectory("rectilinear", samples=31)
+    batch = rpr3gen.inverse_dynamics(model, traj.q, traj.qd, traj.qdd, backend="c")
+    for backend in ("c", "numpy"):
+        ev = rpr3gen.SampleEvaluator(model, backend=backend)
+        for i in range(31):
+            out = ev.evaluate(traj.q[i], traj.qd[i], traj.qdd[i])
+            for name, k in ev.index.items():
+                assert out[k] == pytest.approx(batch[name][i], rel=1e-12, abs=1e-12)
+        ev.q[:] = _singular_sample(model)
+        before = ev.out.copy()
+        assert ev() == 2
+        assert np.array_equal(ev.out, before)
