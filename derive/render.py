@@ -67,6 +67,7 @@ def render_variant(actuation: str, digest: str | None = None) -> dict[str, str]:
         "outputs": [(k, numpy_code(rhs)) for k, (_, rhs) in enumerate(code.outputs)],
         "c_assignments": [(str(lhs), c_code(rhs)) for lhs, rhs in code.assignments],
         "c_outputs": [(k, c_code(rhs)) for k, (_, rhs) in enumerate(code.outputs)],
+        "conditioning_index": spec.output_names.index("conditioning"),
         "params_doc": PARAM_DOCS,
         "outputs_doc": OUTPUT_DOCS,
     }

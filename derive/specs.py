@@ -48,7 +48,18 @@ OUTPUT_FAMILIES: tuple[OutputFamily, ...] = (
     OutputFamily("f32z", "N", "force of the piston on the platform at A3, along z2 = e"),
 )
 
-OUTPUT_NAMES: tuple[str, ...] = tuple(f"{f.name}_{leg}" for f in OUTPUT_FAMILIES for leg in LEGS)
+#: Outputs that are one per sample, not per leg.
+SAMPLE_OUTPUTS: tuple[OutputFamily, ...] = (
+    OutputFamily(
+        "conditioning",
+        "1",
+        "closeness to a parallel singularity, 0 (singular) to 1 (see virtual_work.conditioning)",
+    ),
+)
+
+OUTPUT_NAMES: tuple[str, ...] = tuple(
+    f"{f.name}_{leg}" for f in OUTPUT_FAMILIES for leg in LEGS
+) + tuple(f.name for f in SAMPLE_OUTPUTS)
 
 
 def _param_doc(name: str) -> tuple[str, str]:
@@ -85,7 +96,7 @@ PARAM_DOCS: tuple[tuple[str, str, str], ...] = tuple(
 )
 OUTPUT_DOCS: tuple[tuple[str, str, str], ...] = tuple(
     (f"{f.name}_{leg}", f.unit, f.meaning) for f in OUTPUT_FAMILIES for leg in LEGS
-)
+) + tuple((f.name, f.unit, f.meaning) for f in SAMPLE_OUTPUTS)
 
 
 @dataclass(frozen=True)

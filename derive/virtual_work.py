@@ -156,11 +156,12 @@ def joint_loads(
         rows.append([prog.define(f"W_{leg}{k + 1}", row[k], STEP_CLOSURE) for k in range(3)])
     W = sp.Matrix(rows)
     det = prog.define("det_W", W.det(method="bareiss"), STEP_CLOSURE)
+    inv_det = prog.define("inv_det_W", 1 / det, STEP_CLOSURE)
     adjugate = W.adjugate()
     inverse = sp.Matrix(
         3,
         3,
-        lambda i, j: prog.define(f"Winv_{i + 1}{j + 1}", adjugate[i, j] / det, STEP_CLOSURE),
+        lambda i, j: prog.define(f"Winv_{i + 1}{j + 1}", adjugate[i, j] * inv_det, STEP_CLOSURE),
     )
 
     power = {
@@ -201,4 +202,28 @@ def joint_loads(
                     v = prog.define(f"{f}_v_{load_name}__{other}", value, STEP_VIRTUAL)
                     total = total + v * power[(other, f)]
             loads[load_name] = prog.define(load_name, total, STEP_LOADS)
+    loads["conditioning"] = prog.define("conditioning", conditioning(W, det), STEP_CLOSURE)
     return loads
+
+
+def platform_radius() -> sp.Expr:
+    """Root-mean-square distance of the platform joints from G (m): the length that makes the
+    platform's rotation commensurable with its translation."""
+    squares = sum(
+        (syms.platform_joint(leg).T * syms.platform_joint(leg))[0] for leg in syms.LEGS
+    )
+    return sp.sqrt(squares / 3)
+
+
+def conditioning(W: sp.Matrix, det: sp.Expr) -> sp.Expr:
+    """Closeness to a parallel singularity, dimensionless, in [0, 1]: 0 at a singular pose.
+
+    ``|det(W S)| / prod_i |row_i(W S)|`` with ``S = diag(1, 1, 1/rho)`` (rho:
+    :func:`platform_radius`), the Hadamard ratio of the closure matrix W whose solve gives every
+    load. It is 1 when the three legs' constraint lines are mutually orthogonal in the scaled
+    twist space and falls to 0 as they become dependent (legs' constraint lines concurrent or
+    parallel), where the loads grow without bound.
+    """
+    rho = platform_radius()
+    norms = [sp.sqrt(W[i, 0] ** 2 + W[i, 1] ** 2 + (W[i, 2] / rho) ** 2) for i in range(3)]
+    return sp.Abs(det) / (rho * norms[0] * norms[1] * norms[2])

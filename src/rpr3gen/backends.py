@@ -21,8 +21,14 @@ _FAMILIES = (
     "phi10", "lambda21", "phi32", "omega10", "v21", "omega32", "eps10", "gamma21", "eps32",
     "m10", "f10x", "f10y", "f21y", "f21z", "m21", "f32y", "f32z",
 )  # fmt: skip
-#: Output names, family-major (``phi10_A, phi10_B, phi10_C, lambda21_A, ...``), as conventions.md.
-OUTPUT_NAMES: tuple[str, ...] = tuple(f"{f}_{leg}" for f in _FAMILIES for leg in "ABC")
+#: Output names, family-major (``phi10_A, phi10_B, phi10_C, lambda21_A, ...``), as conventions.md,
+#: then ``conditioning``: closeness to a parallel singularity, 0 (singular) to 1.
+OUTPUT_NAMES: tuple[str, ...] = (
+    *(f"{f}_{leg}" for f in _FAMILIES for leg in "ABC"),
+    "conditioning",
+)
+#: Below this conditioning a pose is singular: its outputs are NaN (as RPR3_MIN_CONDITIONING).
+SINGULAR_CONDITIONING = 1e-9
 
 
 def numpy_module(actuation: str) -> ModuleType:
@@ -83,11 +89,19 @@ def inverse_dynamics(
 
     Returns:
         ``{name: (n,) array}`` for every name of :data:`OUTPUT_NAMES` (conventions.md: loads
-        exerted by body k-1 on body k, SI units). A sample at a singular pose gives inf or nan
-        (numpy) or nan (c). With ``"c"`` the arrays are strided views of one row-major block.
+        exerted by body k-1 on body k, SI units). A sample whose input is not finite or whose
+        pose is singular (``conditioning`` under :data:`SINGULAR_CONDITIONING`, or a result
+        not finite) gives NaN in every output, with either backend; no error is raised, so
+        callers decide (``rpr3gen simulate`` refuses such a trajectory). With ``"c"`` the arrays
+        are strided views of one row-major block.
     """
     q, qd, qdd = _samples("q", q), _samples("qd", qd), _samples("qdd", qdd)
     if not q.shape == qd.shape == qdd.shape:
         raise Rpr3genError(f"q, qd, qdd differ in shape: {q.shape}, {qd.shape}, {qdd.shape}")
     out = _evaluate(model, q, qd, qdd, backend)
+    with np.errstate(invalid="ignore"):
+        singular = ~(out[-1] >= SINGULAR_CONDITIONING) | ~np.isfinite(out).all(axis=0)
+        singular |= ~np.isfinite(np.stack([q, qd, qdd], axis=0)).all(axis=(0, 2))
+    if singular.any():
+        out[:, singular] = np.nan
     return dict(zip(OUTPUT_NAMES, out, strict=True))

@@ -10,6 +10,7 @@ import argparse
 import sys
 from collections.abc import Sequence
 from pathlib import Path
+from typing import NoReturn
 
 import numpy as np
 
@@ -17,18 +18,28 @@ from rpr3gen.backends import BACKENDS, OUTPUT_NAMES, inverse_dynamics
 from rpr3gen.errors import Rpr3genError
 from rpr3gen.model import Model, load_model
 from rpr3gen.trajectory import PAPER_TRAJECTORIES, Trajectory, paper_trajectory, read_trajectory_csv
+from rpr3gen.validity import DEFAULT_MIN_CONDITIONING, invalid_samples
 
 EXIT_ERROR = 2
 
 
+class _Parser(argparse.ArgumentParser):
+    """Usage errors as one line, like every other error of the command."""
+
+    def error(self, message: str) -> NoReturn:
+        self.exit(EXIT_ERROR, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
 def _parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="rpr3gen",
         description="Inverse dynamics of the 3-RPR planar parallel robot (Staicu), "
         "from generated code.",
     )
     parser.add_argument("--debug", action="store_true", help="show tracebacks on errors")
-    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    sub = parser.add_subparsers(
+        dest="command", required=True, metavar="COMMAND", parser_class=_Parser
+    )
 
     sim = sub.add_parser("simulate", help="evaluate the inverse dynamics over a trajectory")
     sim.add_argument("--model", metavar="FILE", help="model TOML file (default: the paper's)")
@@ -43,6 +54,20 @@ def _parser() -> argparse.ArgumentParser:
     sim.add_argument("--backend", choices=BACKENDS, default="numpy")
     sim.add_argument("--out", metavar="FILE.csv", help="write every output as CSV")
     sim.add_argument("--plots", metavar="DIR", help="write the paper's figures as PNG")
+    sim.add_argument(
+        "--min-conditioning",
+        type=float,
+        default=DEFAULT_MIN_CONDITIONING,
+        metavar="C",
+        help="refuse poses whose output 'conditioning' (0 = singular, 1 = best) is below C "
+        f"(default {DEFAULT_MIN_CONDITIONING:g})",
+    )
+    sim.add_argument(
+        "--allow-invalid",
+        action="store_true",
+        help="write rows at poses too close to a singularity or outside a stroke limit as NaN "
+        "instead of refusing the trajectory",
+    )
 
     paper = sub.add_parser("paper", help="run the paper's two examples: CSV and figures")
     paper.add_argument("--out", default="results", metavar="DIR", help="default: ./results")
@@ -72,15 +97,26 @@ def _trajectory(args: argparse.Namespace) -> tuple[str, Trajectory]:
     return path.stem, read_trajectory_csv(path)
 
 
-def _check_finite(traj: Trajectory, out: dict[str, np.ndarray]) -> None:
-    block = np.vstack([out[name] for name in OUTPUT_NAMES])
-    bad = ~np.isfinite(block).all(axis=0)
-    if bad.any():
-        first = int(np.argmax(bad))
+def _screen(
+    model: Model,
+    traj: Trajectory,
+    out: dict[str, np.ndarray],
+    min_conditioning: float,
+    allow_invalid: bool,
+) -> None:
+    """Refuse a trajectory through an invalid pose, or blank those rows when allowed."""
+    invalid = invalid_samples(model, out, min_conditioning)
+    if invalid is None:
+        return
+    if not allow_invalid:
+        k = invalid.first
         raise Rpr3genError(
-            f"singular or degenerate pose at t = {traj.t[first]:.6g} s (sample {first + 1}): "
-            f"the outputs are not finite"
+            f"t = {traj.t[k]:.6g} s (sample {k + 1} of {len(traj.t)}): {invalid.reason}; "
+            "pass --allow-invalid to write such rows as NaN"
         )
+    for name in OUTPUT_NAMES:
+        if name != "conditioning":
+            out[name] = np.where(invalid.mask, np.nan, out[name])
 
 
 def simulate(
@@ -90,12 +126,19 @@ def simulate(
     backend: str,
     out_csv: str | None,
     plots_dir: str | None,
+    min_conditioning: float = DEFAULT_MIN_CONDITIONING,
+    allow_invalid: bool = False,
 ) -> dict[str, np.ndarray]:
-    """Evaluate, check, and write the CSV and figures of one trajectory."""
+    """Evaluate, screen, and write the CSV and figures of one trajectory.
+
+    Nothing is written unless the whole trajectory is valid (or ``allow_invalid``).
+    """
     from rpr3gen.atomic import write_results_csv
 
+    if not min_conditioning >= 0.0:
+        raise Rpr3genError(f"--min-conditioning must be >= 0, got {min_conditioning}")
     out = inverse_dynamics(model, traj.q, traj.qd, traj.qdd, backend=backend)
-    _check_finite(traj, out)
+    _screen(model, traj, out, min_conditioning, allow_invalid)
     if out_csv:
         Path(out_csv).parent.mkdir(parents=True, exist_ok=True)
         write_results_csv(out_csv, traj.t, traj.q, out, OUTPUT_NAMES)
@@ -117,7 +160,7 @@ def _summary(name: str, model: Model, traj: Trajectory, out: dict[str, np.ndarra
     lines = [f"{name}: {len(traj.t)} samples over {traj.t[-1] - traj.t[0]:g} s, model {model.name}"]
     lines.append(f"  {'peak |value|':<12} {'leg A':>12} {'leg B':>12} {'leg C':>12}")
     for family in ("m10", "f21z", "f10x", "f10y", "f21y", "m21", "f32y", "f32z"):
-        peaks = [float(np.max(np.abs(out[f"{family}_{leg}"]))) for leg in "ABC"]
+        peaks = [float(np.nanmax(np.abs(out[f"{family}_{leg}"]), initial=0.0)) for leg in "ABC"]
         lines.append(f"  {family:<12} " + " ".join(f"{p:12.5g}" for p in peaks))
     return "\n".join(lines)
 
@@ -125,7 +168,16 @@ def _summary(name: str, model: Model, traj: Trajectory, out: dict[str, np.ndarra
 def _cmd_simulate(args: argparse.Namespace) -> int:
     model = load_model(args.model)
     name, traj = _trajectory(args)
-    out = simulate(model, name, traj, args.backend, args.out, args.plots)
+    out = simulate(
+        model,
+        name,
+        traj,
+        args.backend,
+        args.out,
+        args.plots,
+        min_conditioning=args.min_conditioning,
+        allow_invalid=args.allow_invalid,
+    )
     print(_summary(name, model, traj, out))
     return 0
 

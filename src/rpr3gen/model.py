@@ -61,6 +61,7 @@ _SCHEMA: dict[str, Any] = {
     "mass": dict.fromkeys(("m1", "m2", "m3", "c1", "c2", "J1", "J2", "J3")),
     "environment": {"gravity": None},
     "payload": {"force": None, "moment": None},
+    "limits": {"stroke": None},
 }
 
 
@@ -102,12 +103,15 @@ class Model:
             inertias (kg m², about the COM, axis z), gravity ``gx, gy`` (m/s²) and the payload
             wrench at G ``fx, fy`` (N), ``mz`` (N m).
         source: Where the model came from (a file path or ``"<dict>"``), for messages.
+        stroke: Optional piston displacement bounds ``((lo, hi), ...)`` for legs A, B, C (m,
+            bounds on lambda21), from ``[limits] stroke``; None when the file sets none.
     """
 
     name: str
     actuation: str
     params: Mapping[str, float]
     source: str
+    stroke: tuple[tuple[float, float], ...] | None = None
 
     def __post_init__(self) -> None:
         if self.actuation not in ACTUATIONS:
@@ -224,7 +228,24 @@ class _Reader:
         force = self.vector(payload, "payload.force", "force", 2, (0.0, 0.0))
         params["fx"], params["fy"] = force
         params["mz"] = self.number(payload, "payload.moment", "moment", default=0.0)
-        return Model(name=name, actuation=actuation, params=params, source=self.source)
+        stroke = self.stroke(self.table(data, "limits", required=False))
+        return Model(
+            name=name, actuation=actuation, params=params, source=self.source, stroke=stroke
+        )
+
+    def stroke(self, limits: Mapping[str, Any]) -> tuple[tuple[float, float], ...] | None:
+        """``[limits] stroke = [[lo, hi], [lo, hi], [lo, hi]]``: lambda21 bounds per leg (m)."""
+        if "stroke" not in limits:
+            return None
+        shape = "a list of 3 bounds [[lo, hi], [lo, hi], [lo, hi]] (m), for legs A, B, C"
+        bounds = self.points(limits, "limits.stroke", "stroke", shape)
+        for leg, (lo, hi) in zip(LEGS, bounds, strict=True):
+            if not lo < hi:
+                self.fail(
+                    f"limits.stroke[{LEGS.index(leg)}]",
+                    f"leg {leg}: the lower bound must be below the upper, got [{lo:g}, {hi:g}]",
+                )
+        return tuple((lo, hi) for lo, hi in bounds)
 
     def check_keys(self, table: Mapping[Any, Any], schema: Mapping[str, Any], prefix: str) -> None:
         for key in table:
@@ -304,9 +325,14 @@ class _Reader:
             self.fail(dotted, f"must be a list of {length} numbers, got {_describe(table[key])}")
         return tuple(self.scalar(v, f"{dotted}[{i}]") for i, v in enumerate(value))
 
-    def points(self, table: Mapping[str, Any], dotted: str, key: str) -> list[tuple[float, ...]]:
+    def points(
+        self,
+        table: Mapping[str, Any],
+        dotted: str,
+        key: str,
+        shape: str = "a list of 3 points [[x, y], [x, y], [x, y]]",
+    ) -> list[tuple[float, ...]]:
         value = _as_list(table[key])
-        shape = "a list of 3 points [[x, y], [x, y], [x, y]]"
         if not isinstance(value, list) or len(value) != 3:
             self.fail(dotted, f"must be {shape}, got {_describe(table[key])}")
         return [self.vector({"p": p}, f"{dotted}[{i}]", "p", 2) for i, p in enumerate(value)]
