@@ -44,7 +44,8 @@ def body_motions(kin: LegKinematics) -> tuple[BodyMotion, BodyMotion, BodyMotion
 
     ``omega_k0 = a_k,k-1 omega_k-1,0 + omega_k,k-1 u3``, and
     ``gamma_k0 = a_k,k-1 [gamma_k-1,0 + (~omega ~omega + ~eps)_k-1,0 r_k,k-1]
-    + 2 v_k,k-1 ~omega_k0 u3 + gamma_k,k-1 u3``.
+    + 2 v_k,k-1 ~omega_k0 u3 + gamma_k,k-1 u3``. For the platform, whose motion is given,
+    gamma_30 is the acceleration of A3 found in eq. (9), turned into frame 3.
     """
     cyl = BodyMotion(omega=kin.omega10 * u3, eps=kin.eps10 * u3, gamma=ZERO)
     r21 = (syms.l0 + kin.lambda21) * u1  # A1 -> A2 in frame 1
@@ -56,11 +57,12 @@ def body_motions(kin: LegKinematics) -> tuple[BodyMotion, BodyMotion, BodyMotion
         + 2 * kin.v21 * skew(omega20) * u3
         + kin.gamma21 * u3,
     )
-    r32 = syms.l2 * u3  # A2 -> A3 in frame 2
+    # The platform's motion is the input: its point A3 accelerates as eq. (9) found (frame 1),
+    # which equals the chain recursion a32 [gamma_20 + (~w ~w + ~eps)_20 r32] with fewer terms.
     platform = BodyMotion(
         omega=kin.a32 * piston.omega + kin.omega32 * u3,
         eps=kin.a32 * piston.eps + kin.eps32 * u3,
-        gamma=kin.a32 * (piston.gamma + (skew(piston.omega) ** 2 + skew(piston.eps)) * r32),
+        gamma=kin.a32 * kin.a21 * kin.accel_a3,
     )
     return cyl, piston, platform
 
@@ -119,7 +121,6 @@ def leg_wrenches(prog: Program, kin: LegKinematics, carries_platform: bool) -> L
     F20 = prog.define_vector(f"F20_{leg}", F20, step)
     M20 = prog.define_vector(f"M20_{leg}", M20, step)
     if carries_platform:
-        a30 = kin.a32 * kin.a21 * kin.a10
         rho2 = (kin.rho.T * kin.rho)[0]
         F30, M30 = required_wrench(
             platform,
@@ -127,8 +128,8 @@ def leg_wrenches(prog: Program, kin: LegKinematics, carries_platform: bool) -> L
             kin.rho,
             sp.diag(0, 0, syms.J3 + syms.m3 * rho2),
             g3,
-            external_force=a30 * syms.payload_force,
-            external_moment=a30 * syms.payload_moment,
+            external_force=kin.a32 * kin.a21 * kin.a10 * syms.payload_force,
+            external_moment=syms.payload_moment,  # about z3 = z0
         )
         F3 = prog.define_vector(f"F3_{leg}", F30, step)
         M3 = prog.define_vector(f"M3_{leg}", M30, step)

@@ -34,6 +34,7 @@ class LegKinematics:
     a21: sp.Matrix
     a32: sp.Matrix
     rho: sp.Matrix  # G - A3 in frame 3 (constant), the paper's r_3^GA
+    accel_a3: sp.Matrix  # acceleration of the platform point A3, in frame 1
     connectivity: sp.Matrix  # K of eq. (6) written in frame 1: K (omega10, v21, omega32) = rhs
     omega10: sp.Expr
     v21: sp.Expr
@@ -141,10 +142,17 @@ def leg_kinematics(prog: Program, leg: str, cos_phi: sp.Expr, sin_phi: sp.Expr) 
     )
     a_a3_1 = a10 * a_a3
     # Derivative of (6): the same matrix; the velocity products move to the right-hand side.
+    accel_a3 = sp.Matrix(
+        [
+            prog.define(f"aA3_x1_{leg}", a_a3_1[0], step),
+            prog.define(f"aA3_y1_{leg}", a_a3_1[1], step),
+            0,
+        ]
+    )
     rhs = sp.Matrix(
         [
-            prog.define(f"aA3_x1_{leg}", a_a3_1[0], step) + length * omega10**2,
-            prog.define(f"aA3_y1_{leg}", a_a3_1[1], step) - 2 * v21 * omega10,
+            accel_a3[0] + length * omega10**2,
+            accel_a3[1] - 2 * v21 * omega10,
             syms.ddphi,
         ]
     )
@@ -167,6 +175,7 @@ def leg_kinematics(prog: Program, leg: str, cos_phi: sp.Expr, sin_phi: sp.Expr) 
         a21=a21,
         a32=a32,
         rho=rho,
+        accel_a3=accel_a3,
         connectivity=connectivity,
         omega10=omega10,
         v21=v21,

@@ -140,6 +140,8 @@ def joint_loads(
     three rows form the matrix W of the platform's virtual twist t, solved by explicit cofactors.
     The free velocities then follow as ``f1 = (c2 x w) . r / (c2 x w) . c1`` and
     ``f2 = (c1 x w) . r / (c1 x w) . c2``, with r the twist not produced by loaded joints.
+
+    Also returns ``conditioning``, the closeness of W to singularity (:func:`conditioning`).
     """
     legs = tuple(kinematics)
     free = FREE[actuation]
@@ -170,37 +172,44 @@ def joint_loads(
         for name, joint in joints[leg].items()
     }
 
+    def free_velocities(leg: str, r: sp.Matrix) -> tuple[sp.Expr, sp.Expr]:
+        """Eq. (7) solved for the free velocities of ``leg``, given the rest r of its closure."""
+        c1, c2 = (joints[leg][f].column for f in free)
+        d1, d2 = _cross(c2, null[leg]), _cross(c1, null[leg])
+        return (
+            sp.cancel(_dot(d1, r) / _dot(d1, c1)),
+            sp.cancel(_dot(d2, r) / _dot(d2, c2)),
+        )
+
+    # The virtual motions of eq. (8) for the loads of leg i all move the platform by
+    # b * Winv[:, i] (b: the load's own joint column seen through leg i's closure row), and the
+    # free velocities are linear in that twist. So the bracket of eqs. (12)-(17),
+    # u3^T {v21^A F2^A + omega32^A M3^A + v21^B F2^B + v21^C F2^C}, is b times one bracket Q_i
+    # per leg, evaluated once for the unit closure motion t = Winv[:, i], plus the free
+    # velocities that the load's own joint forces in its own leg.
+    bracket: dict[str, sp.Expr] = {}
+    for i, leg in enumerate(legs):
+        unit_twist = inverse[:, i]
+        total = sp.Integer(0)
+        for other in legs:
+            values = free_velocities(other, twist[other] * unit_twist)
+            for f, value in zip(free, values, strict=True):
+                v = prog.define(f"{f}_v_{leg}__{other}", value, STEP_VIRTUAL)
+                total = total + v * power[(other, f)]
+        bracket[leg] = prog.define(f"Q_{leg}", total, STEP_VIRTUAL)
+
     loads: dict[str, sp.Expr] = {}
     for leg in legs:
         for name, joint in joints[leg].items():
             if name in free or name not in LOAD_OF:
                 continue
-            load_name = f"{LOAD_OF[name]}_{leg}"
             # Eq. (8): this velocity = 1, every other loaded one = 0; eq. (7) closes the chains.
             b = _dot(null[leg], joint.column)
-            t = sp.Matrix(
-                [
-                    prog.define(
-                        f"t{k + 1}_v_{load_name}", b * inverse[k, legs.index(leg)], STEP_VIRTUAL
-                    )
-                    for k in range(3)
-                ]
-            )
-            total = power[(leg, name)]
-            for other in legs:
-                r = twist[other] * t
-                if other == leg:
-                    r = r - joint.column
-                c1, c2 = (joints[other][f].column for f in free)
-                w = null[other]
-                d1, d2 = _cross(c2, w), _cross(c1, w)
-                values = (
-                    sp.cancel(_dot(d1, r) / _dot(d1, c1)),
-                    sp.cancel(_dot(d2, r) / _dot(d2, c2)),
-                )
-                for f, value in zip(free, values, strict=True):
-                    v = prog.define(f"{f}_v_{load_name}__{other}", value, STEP_VIRTUAL)
-                    total = total + v * power[(other, f)]
+            own = free_velocities(leg, -joint.column)
+            total = power[(leg, name)] + b * bracket[leg]
+            for f, value in zip(free, own, strict=True):
+                total = total + value * power[(leg, f)]
+            load_name = f"{LOAD_OF[name]}_{leg}"
             loads[load_name] = prog.define(load_name, total, STEP_LOADS)
     loads["conditioning"] = prog.define("conditioning", conditioning(W, det), STEP_CLOSURE)
     return loads

@@ -7,6 +7,9 @@ sub-package per actuation scheme; this module only shapes arrays and picks the v
 from __future__ import annotations
 
 import importlib
+import os
+import sys
+from collections.abc import Iterator
 from types import ModuleType
 
 import numpy as np
@@ -29,6 +32,9 @@ OUTPUT_NAMES: tuple[str, ...] = (
 )
 #: Below this conditioning a pose is singular: its outputs are NaN (as RPR3_MIN_CONDITIONING).
 SINGULAR_CONDITIONING = 1e-9
+#: Samples evaluated per call of the generated code: the NumPy temporaries of one block stay
+#: in cache and memory stays bounded however long the trajectory (benchmarks/ measures this).
+BLOCK = 8192
 
 
 def numpy_module(actuation: str) -> ModuleType:
@@ -50,14 +56,53 @@ def _samples(name: str, value: ArrayLike) -> np.ndarray:
     return np.ascontiguousarray(array)
 
 
+def _blocks(n: int, progress: bool) -> Iterator[slice]:
+    """Consecutive blocks of at most :data:`BLOCK` samples, with a progress bar on request.
+
+    The bar goes to stderr, only when it is a terminal and the run lasts over half a second.
+    """
+    starts = range(0, n, BLOCK)
+    if progress and sys.stderr.isatty() and n > BLOCK:
+        from tqdm import tqdm
+
+        try:  # a terminal that reports no size (serial consoles, some CI) gets 80 x 24
+            size = os.get_terminal_size(sys.stderr.fileno())
+        except OSError:
+            size = os.terminal_size((0, 0))
+        bar = tqdm(
+            total=n,
+            unit="sample",
+            unit_scale=True,
+            delay=0.5,
+            leave=False,
+            ncols=size.columns or 80,
+            nrows=size.lines or 24,
+        )
+        for lo in starts:
+            yield slice(lo, min(lo + BLOCK, n))
+            bar.update(min(BLOCK, n - lo))
+        bar.close()
+    else:
+        for lo in starts:
+            yield slice(lo, min(lo + BLOCK, n))
+
+
 def _evaluate(
-    model: Model, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, backend: str
+    model: Model,
+    q: np.ndarray,
+    qd: np.ndarray,
+    qdd: np.ndarray,
+    backend: str,
+    progress: bool = False,
 ) -> np.ndarray:
     """All outputs as a (NUM_OUTPUTS, n) array; rows of a singular sample are inf or nan."""
+    n = q.shape[0]
     if backend == "numpy":
         module = numpy_module(model.actuation)
-        out = np.empty((len(OUTPUT_NAMES), q.shape[0]))
-        module.rpr3_inverse_dynamics(model.vector(module.PARAM_NAMES), q, qd, qdd, out)
+        params = model.vector(module.PARAM_NAMES)
+        out = np.empty((len(OUTPUT_NAMES), n))
+        for block in _blocks(n, progress):
+            module.rpr3_inverse_dynamics(params, q[block], qd[block], qdd[block], out[:, block])
         return out
     if backend == "c":
         from rpr3gen import cbackend
@@ -65,7 +110,12 @@ def _evaluate(
         param_names, output_names = cbackend.names(model.actuation)
         if output_names != OUTPUT_NAMES:
             raise Rpr3genError("generated C does not match this runtime; run `rpr3gen generate`")
-        rows, _ = cbackend.batch(model.vector(param_names), q, qd, qdd, model.actuation)
+        params = model.vector(param_names)
+        rows = np.empty((n, len(OUTPUT_NAMES)))
+        for block in _blocks(n, progress):
+            cbackend.batch(
+                params, q[block], qd[block], qdd[block], model.actuation, out=rows[block]
+            )
         return rows.T
     raise Rpr3genError(f"unknown backend {backend!r}; choose one of {', '.join(BACKENDS)}")
 
@@ -76,6 +126,7 @@ def inverse_dynamics(
     qd: ArrayLike,
     qdd: ArrayLike,
     backend: str = "numpy",
+    progress: bool = False,
 ) -> dict[str, np.ndarray]:
     """Leg kinematics, actuator loads and every joint load for n platform samples.
 
@@ -86,6 +137,7 @@ def inverse_dynamics(
         qdd: (n, 3) acceleration (ddx, ddy, ddphi).
         backend: ``"numpy"`` (generated NumPy) or ``"c"`` (generated C, compiled on first use
             and cached; see :mod:`rpr3gen.cbackend`).
+        progress: show a progress bar on stderr when it is a terminal (long trajectories).
 
     Returns:
         ``{name: (n,) array}`` for every name of :data:`OUTPUT_NAMES` (conventions.md: loads
@@ -98,7 +150,7 @@ def inverse_dynamics(
     q, qd, qdd = _samples("q", q), _samples("qd", qd), _samples("qdd", qdd)
     if not q.shape == qd.shape == qdd.shape:
         raise Rpr3genError(f"q, qd, qdd differ in shape: {q.shape}, {qd.shape}, {qdd.shape}")
-    out = _evaluate(model, q, qd, qdd, backend)
+    out = _evaluate(model, q, qd, qdd, backend, progress)
     with np.errstate(invalid="ignore"):
         singular = ~(out[-1] >= SINGULAR_CONDITIONING) | ~np.isfinite(out).all(axis=0)
         singular |= ~np.isfinite(np.stack([q, qd, qdd], axis=0)).all(axis=(0, 2))

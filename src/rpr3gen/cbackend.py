@@ -118,9 +118,17 @@ def names(actuation: str) -> tuple[tuple[str, ...], tuple[str, ...]]:
 
 
 def batch(
-    params: np.ndarray, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, actuation: str
+    params: np.ndarray,
+    q: np.ndarray,
+    qd: np.ndarray,
+    qdd: np.ndarray,
+    actuation: str,
+    out: np.ndarray | None = None,
 ) -> tuple[np.ndarray, int]:
-    """Evaluate n samples (contiguous float64 arrays).
+    """Evaluate n samples (float64 arrays; q, qd, qdd (n, 3) C-contiguous).
+
+    Args:
+        out: optional C-contiguous (n, NUM_OUTPUTS) array to write into.
 
     Returns:
         ``out`` of shape (n, NUM_OUTPUTS), row-major as the C ABI, and the number of failed
@@ -128,7 +136,12 @@ def batch(
     """
     lib = library(actuation)
     _, output_names = names(actuation)
-    out = np.empty((q.shape[0], len(output_names)))
+    if out is None:
+        out = np.empty((q.shape[0], len(output_names)))
+    if not out.flags.c_contiguous or out.shape != (q.shape[0], len(output_names)):
+        raise ValueError(f"out must be C-contiguous of shape {(q.shape[0], len(output_names))}")
+    params = np.ascontiguousarray(params, dtype=np.float64)
+    q, qd, qdd = (np.ascontiguousarray(a, dtype=np.float64) for a in (q, qd, qdd))
     failed = lib.rpr3_inverse_dynamics_batch(
         params.ctypes.data, q.shape[0], q.ctypes.data, qd.ctypes.data, qdd.ctypes.data,
         out.ctypes.data,

@@ -137,7 +137,7 @@ def simulate(
 
     if not min_conditioning >= 0.0:
         raise Rpr3genError(f"--min-conditioning must be >= 0, got {min_conditioning}")
-    out = inverse_dynamics(model, traj.q, traj.qd, traj.qdd, backend=backend)
+    out = inverse_dynamics(model, traj.q, traj.qd, traj.qdd, backend=backend, progress=True)
     _screen(model, traj, out, min_conditioning, allow_invalid)
     if out_csv:
         Path(out_csv).parent.mkdir(parents=True, exist_ok=True)
