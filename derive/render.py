@@ -14,6 +14,7 @@ from pathlib import Path
 
 import jinja2
 from rpr3gen_derive.cse import straight_line
+from rpr3gen_derive.lowering import lower_numpy
 from rpr3gen_derive.printers import c_code, numpy_code
 from rpr3gen_derive.specs import ACTUATIONS, OUTPUT_DOCS, PARAM_DOCS, build_spec
 
@@ -50,8 +51,13 @@ def render_variant(actuation: str, digest: str | None = None) -> dict[str, str]:
     code = straight_line(spec)
     used = set().union(*(rhs.free_symbols for _, rhs in code.assignments + code.outputs))
     used_names = {str(sym) for sym in used}
+    inputs = {sym: str(sym) for _, symbols in spec.inputs for sym in symbols}
+    params = {sym for sym in used if str(sym) in spec.param_names}
+    rows = {name: f"out[{k}]" for k, name in enumerate(spec.output_names)}
+    lowered = lower_numpy(code, inputs, params, rows)
     env = _environment()
     context = {
+        "lowered": lowered,
         "spec": spec,
         "source_hash": digest or source_hash(),
         "ops_before": code.ops_before,

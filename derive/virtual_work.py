@@ -218,9 +218,7 @@ def joint_loads(
 def platform_radius() -> sp.Expr:
     """Root-mean-square distance of the platform joints from G (m): the length that makes the
     platform's rotation commensurable with its translation."""
-    squares = sum(
-        (syms.platform_joint(leg).T * syms.platform_joint(leg))[0] for leg in syms.LEGS
-    )
+    squares = sum((syms.platform_joint(leg).T * syms.platform_joint(leg))[0] for leg in syms.LEGS)
     return sp.sqrt(squares / 3)
 
 

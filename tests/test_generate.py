@@ -29,7 +29,10 @@ def test_check_detects_hand_edit(
     copy = tmp_path / "generated"
     shutil.copytree(repo_root / "generated", copy)
     target = copy / "revolute" / "rpr3_numpy.py"
-    target.write_text(target.read_text().replace("out[0] =", "out[0] = 1.0 +", 1))
+    text = target.read_text()
+    edited = text.replace("import numpy\n", "import numpy\nimport math\n", 1)
+    assert edited != text
+    target.write_text(edited)
     before = target.read_bytes()
     assert main(["generate", "--check", "--out", str(copy)]) == 2
     err = capsys.readouterr().err

@@ -1,0 +1,244 @@
+"""Lower a straight-line program to NumPy ufunc calls into preallocated buffers.
+
+Each operation becomes one ufunc call with ``out=``, writing into a row of a work array that is
+allocated once per call; a row is reused as soon as the value in it is dead, so the working set
+of a block of samples stays in cache and no temporary array is allocated per operation.
+Subexpressions of parameters only are computed once per call as Python scalars. Outputs that
+are named intermediates are computed straight into their row of ``out``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import sympy as sp
+from rpr3gen_derive.cse import StraightLine
+from rpr3gen_derive.printers import numpy_code
+
+_UFUNC = {sp.cos: "cos", sp.sin: "sin", sp.Abs: "absolute", sp.atan2: "arctan2"}
+
+
+@dataclass
+class LoweredNumpy:
+    """Lines of the generated function body, and the size of its work array."""
+
+    scalar_lines: list[str]
+    vector_lines: list[str]
+    buffers: int
+
+
+@dataclass
+class _Lowering:
+    """State of the lowering: where each symbol lives and which work rows are free.
+
+    A work row holds either an anonymous temporary (freed when an operation consumes it) or the
+    value of named symbols (freed when the last of them is dead: ``refs``).
+    """
+
+    scalars: set[sp.Symbol]
+    location: dict[sp.Symbol, str] = field(default_factory=dict)
+    free: list[int] = field(default_factory=list)
+    temps: set[str] = field(default_factory=set)
+    refs: dict[str, int] = field(default_factory=dict)
+    count: int = 0
+    lines: list[str] = field(default_factory=list)
+
+    def is_scalar(self, expr: sp.Expr) -> bool:
+        return expr.free_symbols <= self.scalars
+
+    def new(self) -> str:
+        if self.free:
+            index = min(self.free)
+            self.free.remove(index)
+        else:
+            index = self.count
+            self.count += 1
+        name = f"w{index}"
+        self.temps.add(name)
+        return name
+
+    def release(self, operand: str) -> None:
+        """Free an anonymous temporary once it has been consumed."""
+        if operand in self.temps:
+            self.temps.discard(operand)
+            self.free.append(int(operand[1:]))
+
+    def bind(self, symbol: sp.Symbol, where: str) -> None:
+        """Give ``symbol`` the value at ``where`` (a temporary becomes a named row)."""
+        self.location[symbol] = where
+        if where in self.temps:
+            self.temps.discard(where)
+            self.refs[where] = 0
+        if where in self.refs:
+            self.refs[where] += 1
+
+    def drop(self, symbol: sp.Symbol) -> None:
+        """``symbol`` is dead: free its row when no other live symbol shares it."""
+        where = self.location.get(symbol)
+        if where in self.refs:
+            self.refs[where] -= 1
+            if self.refs[where] == 0:
+                del self.refs[where]
+                self.free.append(int(where[1:]))
+
+    def call(self, ufunc: str, args: list[str], dest: str | None) -> str:
+        for a in args:
+            self.release(a)
+        target = dest or self.new()
+        self.lines.append(f"numpy.{ufunc}({', '.join(args)}, out={target})")
+        return target
+
+    # -- expressions -------------------------------------------------------------------------
+
+    def scalar(self, expr: sp.Expr) -> str:
+        return f"({numpy_code(expr)})"
+
+    def emit(self, expr: sp.Expr, dest: str | None = None) -> str:
+        """Operand text of ``expr``; written into ``dest`` when one is given."""
+        if self.is_scalar(expr):
+            text = self.scalar(expr)
+            if dest:
+                self.lines.append(f"{dest}.fill({text})")
+                return dest
+            return text
+        if expr.is_Symbol:
+            where = self.location[expr]
+            if dest:
+                self.lines.append(f"numpy.copyto({dest}, {where})")
+                return dest
+            return where
+        if expr.is_Add:
+            return self.add(expr, dest)
+        if expr.is_Mul:
+            return self.mul(expr, dest)
+        if expr.is_Pow:
+            return self.power(expr, dest)
+        if expr.func in _UFUNC:
+            args = [self.emit(a) for a in expr.args]
+            return self.call(_UFUNC[expr.func], args, dest)
+        raise NotImplementedError(f"cannot lower {expr.func.__name__}: {expr}")
+
+    def add(self, expr: sp.Expr, dest: str | None) -> str:
+        scalar = [a for a in expr.args if self.is_scalar(a)]
+        terms = [a for a in expr.args if not self.is_scalar(a)]
+        signed = []
+        for term in terms:
+            coeff, rest = term.as_coeff_Mul()
+            negative = coeff.is_negative
+            signed.append((negative, -term if negative else term))
+        signed.sort(key=lambda item: item[0])  # a positive term first when there is one
+        negative, first = signed[0]
+        rest = signed[1:]
+        last = not rest and not scalar
+        acc = self.emit(first, dest if last and not negative else None)
+        if negative:
+            acc = self.call("negative", [acc], dest if last else None)
+        for k, (negative, term) in enumerate(rest):
+            final = k == len(rest) - 1 and not scalar
+            operand = self.emit(term)
+            ufunc = "subtract" if negative else "add"
+            acc = self.call(ufunc, [acc, operand], dest if final else None)
+        if scalar:
+            acc = self.call("add", [acc, self.scalar(sp.Add(*scalar))], dest)
+        return acc
+
+    def mul(self, expr: sp.Expr, dest: str | None) -> str:
+        scalar = [a for a in expr.args if self.is_scalar(a)]
+        numerator, denominator = [], []
+        for factor in expr.args:
+            if self.is_scalar(factor):
+                continue
+            base, exponent = factor.as_base_exp()
+            if exponent.is_Integer and exponent < 0:
+                denominator.append(base ** (-exponent))
+            else:
+                numerator.append(factor)
+        factors = [self.emit(f) for f in numerator[:1]]
+        steps: list[tuple[str, str]] = [("multiply", self.emit(f)) for f in numerator[1:]]
+        coefficient = self.scalar(sp.Mul(*scalar)) if scalar else None
+        if not numerator:  # c / x
+            acc_text = coefficient or "1.0"
+            divisor = self._product(denominator)
+            return self.call("divide", [acc_text, divisor], dest)
+        acc = factors[0]
+        if coefficient is not None:
+            steps.append(("multiply", coefficient))
+        if denominator:
+            steps.append(("divide", self._product(denominator)))
+        if not steps:
+            return self.emit(numerator[0], dest)
+        for k, (ufunc, operand) in enumerate(steps):
+            final = k == len(steps) - 1
+            acc = self.call(ufunc, [acc, operand], dest if final else None)
+        return acc
+
+    def _product(self, factors: list[sp.Expr]) -> str:
+        acc = self.emit(factors[0])
+        for f in factors[1:]:
+            acc = self.call("multiply", [acc, self.emit(f)], None)
+        return acc
+
+    def power(self, expr: sp.Expr, dest: str | None) -> str:
+        base, exponent = expr.args
+        if exponent == 2:
+            b = self.emit(base)
+            self.release(b)
+            target = dest or self.new()
+            self.lines.append(f"numpy.multiply({b}, {b}, out={target})")
+            return target
+        if exponent == -1:
+            return self.call("divide", ["1.0", self.emit(base)], dest)
+        if exponent == sp.Rational(1, 2):
+            return self.call("sqrt", [self.emit(base)], dest)
+        if exponent == sp.Rational(-1, 2):
+            root = self.call("sqrt", [self.emit(base)], None)
+            return self.call("divide", ["1.0", root], dest)
+        if exponent.is_Integer and exponent > 2:
+            acc = self.emit(base)
+            b = acc
+            for k in range(int(exponent) - 1):
+                final = k == int(exponent) - 2
+                acc = self.call("multiply", [acc, b], dest if final else None)
+            return acc
+        return self.call("power", [self.emit(base), self.scalar(exponent)], dest)
+
+
+def lower_numpy(
+    code: StraightLine,
+    inputs: dict[sp.Symbol, str],
+    params: set[sp.Symbol],
+    output_rows: dict[str, str],
+) -> LoweredNumpy:
+    """Lower ``code`` given where inputs live (``{x: "x"}``) and each output's row text."""
+    statements = list(code.assignments)
+    # Output rows: an output that is a named intermediate is computed in place.
+    alias: dict[sp.Symbol, str] = {}
+    for name, expr in code.outputs:
+        if expr.is_Symbol and expr not in alias and expr not in inputs:
+            alias[expr] = output_rows[name]
+    uses: dict[sp.Symbol, int] = {}
+    for index, (_, rhs) in enumerate(statements):
+        for sym in rhs.free_symbols:
+            uses[sym] = index
+    state = _Lowering(scalars=set(params))
+    state.location.update(inputs)
+    scalar_lines: list[str] = []
+    for index, (lhs, rhs) in enumerate(statements):
+        if state.is_scalar(rhs):
+            state.scalars.add(lhs)
+            scalar_lines.append(f"{lhs} = {numpy_code(rhs)}")
+            continue
+        target = alias.get(lhs)
+        result = state.emit(rhs, target)
+        state.bind(lhs, result)
+        for sym in rhs.free_symbols:  # operands whose last use is this statement
+            if uses.get(sym) == index:
+                state.drop(sym)
+        if lhs not in uses:
+            state.drop(lhs)
+    for name, expr in code.outputs:
+        row = output_rows[name]
+        if expr.is_Symbol and alias.get(expr) == row:
+            continue
+        state.emit(expr, row)
+    return LoweredNumpy(scalar_lines, state.lines, state.count)
