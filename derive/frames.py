@@ -28,19 +28,22 @@ def rot_z(cos_angle: sp.Expr, sin_angle: sp.Expr) -> sp.Matrix:
 
 
 def leg_matrices(
-    cos_theta: sp.Expr, sin_theta: sp.Expr, cos_phi32: sp.Expr, sin_phi32: sp.Expr
+    cos_theta: sp.Expr, sin_theta: sp.Expr, cos_turn: sp.Expr, sin_turn: sp.Expr
 ) -> tuple[sp.Matrix, sp.Matrix, sp.Matrix]:
     """The matrices a10, a21, a32 of eq. (1) for one leg.
 
     ``a10 = rot(z, phi10) rot(z, alpha) = rot(z, theta)`` with ``theta = alpha + phi10`` the world
-    angle of the leg; ``a21 = theta``; ``a32 = rot(z, phi32) theta^T``.
+    angle of the leg; ``a21 = theta``; ``a32 = rot(z, phi32) rot(z, -alpha) theta^T``, a rotation
+    by ``phi - theta`` (``cos_turn``, ``sin_turn``) after ``theta^T``.
 
-    The paper writes ``a32 = rot(z, phi32) a_beta theta^T``; here frame 3 is the paper's frame 3
-    turned back by beta, so that the same derivation serves platforms given by explicit joint
-    points (where no beta exists). Frame 3 only carries intermediates; every output is written
-    in frames 0, 1 or 2, so nothing a user sees depends on this choice.
+    The paper writes ``a32 = rot(z, phi32) a_beta theta^T``. Here the constant turn ``a_beta`` is
+    ``rot(z, -alpha)``, which makes frame 3 parallel to the platform frame G xG yG: the platform
+    joint vector is then a constant in it for any platform, including ones given by explicit
+    joint points (which have no beta), and no trigonometry of alpha is needed. Frame 3 only
+    carries intermediates; every output is written in frames 0, 1 or 2, so nothing a user sees
+    depends on this choice.
     """
     a10 = rot_z(cos_theta, sin_theta)
     a21 = theta
-    a32 = rot_z(cos_phi32, sin_phi32) * theta.T
+    a32 = rot_z(cos_turn, sin_turn) * theta.T
     return a10, a21, a32

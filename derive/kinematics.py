@@ -87,8 +87,6 @@ def leg_kinematics(prog: Program, leg: str, cos_phi: sp.Expr, sin_phi: sp.Expr) 
     Eq. (9): their time derivative, with the same matrix, gives eps10, gamma21, eps32.
     """
     step = STEP_POSE
-    cos_alpha = prog.define(f"cos_alpha_{leg}", sp.cos(syms.alpha(leg)), step)
-    sin_alpha = prog.define(f"sin_alpha_{leg}", sp.sin(syms.alpha(leg)), step)
     p = syms.platform_joint(leg)
     s = prog.define_vector(f"s_{leg}", rot_z(cos_phi, -sin_phi) * p, step)
     leg_vector = sp.Matrix([syms.x, syms.y, 0]) + s - syms.base_pivot(leg)
@@ -97,23 +95,16 @@ def leg_kinematics(prog: Program, leg: str, cos_phi: sp.Expr, sin_phi: sp.Expr) 
     length = prog.define(f"L_{leg}", sp.sqrt(lx**2 + ly**2), step)
     cos_theta = prog.define(f"cos_theta_{leg}", lx / length, step)
     sin_theta = prog.define(f"sin_theta_{leg}", ly / length, step)
-    # phi10 is the leg angle measured from alpha, wrapped to (-pi, pi]: one atan2 of the leg
-    # vector turned back by alpha.
-    phi10 = prog.define(
-        f"phi10_{leg}",
-        sp.atan2(cos_alpha * ly - sin_alpha * lx, cos_alpha * lx + sin_alpha * ly),
-        step,
-    )
+    # phi10 is the leg angle measured from alpha, wrapped to [-pi, pi].
+    phi10 = prog.define(f"phi10_{leg}", syms.wrap_angle(sp.atan2(ly, lx) - syms.alpha(leg)), step)
     lambda21 = prog.define(f"lambda21_{leg}", length - syms.l0 - syms.l2, step)
     phi32 = prog.define(f"phi32_{leg}", syms.phi - phi10, step)  # eq. (4): phi10 + phi32 = phi
-    # phi32 = (phi + alpha) - theta, so its cosine and sine follow without another atan2.
-    cos_pa = cos_phi * cos_alpha - sin_phi * sin_alpha
-    sin_pa = sin_phi * cos_alpha + cos_phi * sin_alpha
-    cos_phi32 = prog.define(f"cos_phi32_{leg}", cos_pa * cos_theta + sin_pa * sin_theta, step)
-    sin_phi32 = prog.define(f"sin_phi32_{leg}", sin_pa * cos_theta - cos_pa * sin_theta, step)
-    a10, a21, a32 = leg_matrices(cos_theta, sin_theta, cos_phi32, sin_phi32)
-    # G - A3 in frame 3: frame 3 turns with the platform, so this is the constant -rot(-alpha) p.
-    rho = -rot_z(cos_alpha, sin_alpha) * p
+    # Frame 3 is parallel to the platform frame (see frames.leg_matrices): it is turned from
+    # frame 2 by phi - theta, whose cosine and sine need no further trigonometry.
+    cos_turn = prog.define(f"cos_turn32_{leg}", cos_phi * cos_theta + sin_phi * sin_theta, step)
+    sin_turn = prog.define(f"sin_turn32_{leg}", sin_phi * cos_theta - cos_phi * sin_theta, step)
+    a10, a21, a32 = leg_matrices(cos_theta, sin_theta, cos_turn, sin_turn)
+    rho = -p  # G - A3 in frame 3, a constant: the paper's r_3^GA
 
     connectivity = leg_connectivity_matrix(length)
 

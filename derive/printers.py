@@ -19,11 +19,18 @@ def prepare(expr: sp.Expr) -> sp.Expr:
     return optimize(expr, [_expand_small_powers])
 
 
+TWO_PI = "6.283185307179586"  # 2 pi, correctly rounded
+PI = "3.141592653589793"
+
+
 class NumpyPrinter(NumPyPrinter):
     """NumPy code over arrays of samples; names qualified as ``numpy.*``."""
 
     def __init__(self) -> None:
         super().__init__({"fully_qualified_modules": True, "inline": True})
+
+    def _print_wrap_angle(self, expr: sp.Expr) -> str:
+        return f"(numpy.remainder({self._print(expr.args[0])} + {PI}, {TWO_PI}) - {PI})"
 
 
 class CPrinter(C99CodePrinter):
@@ -31,6 +38,9 @@ class CPrinter(C99CodePrinter):
 
     def __init__(self) -> None:
         super().__init__({"math_macros": {}})
+
+    def _print_wrap_angle(self, expr: sp.Expr) -> str:
+        return f"remainder({self._print(expr.args[0])}, {TWO_PI})"
 
 
 def numpy_code(expr: sp.Expr) -> str:

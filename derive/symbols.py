@@ -49,6 +49,20 @@ payload_force = sp.Matrix([params["fx"], params["fy"], 0])
 payload_moment = sp.Matrix([0, 0, params["mz"]])
 
 
+class wrap_angle(sp.Function):  # noqa: N801  (a function, named like sympy's)
+    """An angle wrapped into [-pi, pi]: ``x - 2 pi round(x / 2 pi)``.
+
+    Printed as C99 ``remainder(x, 2 pi)`` and as its NumPy equivalent (see printers, lowering).
+    """
+
+    nargs = 1
+
+    def _eval_evalf(self, prec: int) -> sp.Expr:
+        x = self.args[0].evalf(prec)
+        two_pi = 2 * sp.pi.evalf(prec)
+        return (x - two_pi * sp.floor(x / two_pi + sp.Rational(1, 2))).evalf(prec)
+
+
 def base_pivot(leg: str) -> sp.Matrix:
     """World position of the fixed pivot ``A1`` of ``leg`` (m), a 3-vector with z = 0."""
     return sp.Matrix([params[f"x{leg}1"], params[f"y{leg}1"], 0])

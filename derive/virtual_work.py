@@ -215,22 +215,22 @@ def joint_loads(
     return loads
 
 
-def platform_radius() -> sp.Expr:
-    """Root-mean-square distance of the platform joints from G (m): the length that makes the
-    platform's rotation commensurable with its translation."""
+def platform_radius_squared() -> sp.Expr:
+    """Mean squared distance of the platform joints from G (m^2): rho^2, the length that makes
+    the platform's rotation commensurable with its translation."""
     squares = sum((syms.platform_joint(leg).T * syms.platform_joint(leg))[0] for leg in syms.LEGS)
-    return sp.sqrt(squares / 3)
+    return squares / 3
 
 
 def conditioning(W: sp.Matrix, det: sp.Expr) -> sp.Expr:
     """Closeness to a parallel singularity, dimensionless, in [0, 1]: 0 at a singular pose.
 
-    ``|det(W S)| / prod_i |row_i(W S)|`` with ``S = diag(1, 1, 1/rho)`` (rho:
-    :func:`platform_radius`), the Hadamard ratio of the closure matrix W whose solve gives every
-    load. It is 1 when the three legs' constraint lines are mutually orthogonal in the scaled
-    twist space and falls to 0 as they become dependent (legs' constraint lines concurrent or
-    parallel), where the loads grow without bound.
+    ``|det(W S)| / prod_i |row_i(W S)|`` with ``S = diag(1, 1, 1/rho)`` (rho^2:
+    :func:`platform_radius_squared`), the Hadamard ratio of the closure matrix W whose solve
+    gives every load. It is 1 when the three legs' constraint lines are mutually orthogonal in
+    the scaled twist space and falls to 0 as they become dependent (legs' constraint lines
+    concurrent or parallel), where the loads grow without bound. Computed with one square root.
     """
-    rho = platform_radius()
-    norms = [sp.sqrt(W[i, 0] ** 2 + W[i, 1] ** 2 + (W[i, 2] / rho) ** 2) for i in range(3)]
-    return sp.Abs(det) / (rho * norms[0] * norms[1] * norms[2])
+    rho2 = platform_radius_squared()
+    norms2 = [W[i, 0] ** 2 + W[i, 1] ** 2 + W[i, 2] ** 2 / rho2 for i in range(3)]
+    return sp.sqrt(det**2 / (rho2 * norms2[0] * norms2[1] * norms2[2]))
