@@ -96,7 +96,8 @@ def leg_kinematics(prog: Program, leg: str, cos_phi: sp.Expr, sin_phi: sp.Expr) 
     cos_theta = prog.define(f"cos_theta_{leg}", lx / length, step)
     sin_theta = prog.define(f"sin_theta_{leg}", ly / length, step)
     # phi10 is the leg angle measured from alpha, wrapped to [-pi, pi].
-    phi10 = prog.define(f"phi10_{leg}", syms.wrap_angle(sp.atan2(ly, lx) - syms.alpha(leg)), step)
+    turn = prog.define(f"theta_minus_alpha_{leg}", sp.atan2(ly, lx) - syms.alpha(leg), step)
+    phi10 = prog.define(f"phi10_{leg}", syms.wrap_angle(turn), step)
     lambda21 = prog.define(f"lambda21_{leg}", length - syms.l0 - syms.l2, step)
     phi32 = prog.define(f"phi32_{leg}", syms.phi - phi10, step)  # eq. (4): phi10 + phi32 = phi
     # Frame 3 is parallel to the platform frame (see frames.leg_matrices): it is turned from

@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 
 import sympy as sp
 from rpr3gen_derive.cse import StraightLine
-from rpr3gen_derive.printers import PI, TWO_PI, numpy_code
+from rpr3gen_derive.printers import INV_TWO_PI, TWO_PI, numpy_code
 from rpr3gen_derive.symbols import wrap_angle
 
 _UFUNC = {sp.cos: "cos", sp.sin: "sin", sp.Abs: "absolute", sp.atan2: "arctan2"}
@@ -114,10 +114,13 @@ class _Lowering:
             return self.mul(expr, dest)
         if expr.is_Pow:
             return self.power(expr, dest)
-        if expr.func is wrap_angle:
-            shifted = self.call("add", [self.emit(expr.args[0]), PI], None)
-            turned = self.call("remainder", [shifted, TWO_PI], None)
-            return self.call("subtract", [turned, PI], dest)
+        if expr.func is wrap_angle:  # x - 2 pi rint(x / 2 pi)
+            x = self.emit(expr.args[0])
+            turns = self.new()
+            self.lines.append(f"numpy.multiply({x}, {INV_TWO_PI}, out={turns})")
+            self.lines.append(f"numpy.rint({turns}, out={turns})")
+            self.lines.append(f"numpy.multiply({turns}, {TWO_PI}, out={turns})")
+            return self.call("subtract", [x, turns], dest)
         if expr.func in _UFUNC:
             args = [self.emit(a) for a in expr.args]
             return self.call(_UFUNC[expr.func], args, dest)

@@ -52,7 +52,8 @@ payload_moment = sp.Matrix([0, 0, params["mz"]])
 class wrap_angle(sp.Function):  # noqa: N801  (a function, named like sympy's)
     """An angle wrapped into [-pi, pi]: ``x - 2 pi round(x / 2 pi)``.
 
-    Printed as C99 ``remainder(x, 2 pi)`` and as its NumPy equivalent (see printers, lowering).
+    Printed as ``x - 2 pi nearbyint(x / 2 pi)`` in C99 and with ``numpy.rint`` in NumPy (see
+    printers, lowering); within an ulp or two of C99 ``remainder(x, 2 pi)``, and much cheaper.
     """
 
     nargs = 1

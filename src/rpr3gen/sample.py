@@ -46,8 +46,9 @@ class SampleEvaluator:
                 raise Rpr3genError("generated C does not match this runtime; run rpr3gen generate")
             self.params = np.ascontiguousarray(model.vector(param_names))
             buffers = (self.params, self.q, self.qd, self.qdd, self.out)
-            self._args = tuple(ctypes.c_void_p(b.ctypes.data) for b in buffers)
-            self._call = cbackend.library(model.actuation).rpr3_inverse_dynamics
+            self._packed = cbackend.Call(*(b.ctypes.data for b in buffers))
+            self._args = (ctypes.c_void_p(ctypes.addressof(self._packed)),)
+            self._call = cbackend.library(model.actuation).rpr3_call_packed
         elif backend == "numpy":
             module = numpy_module(model.actuation)
             self.params = model.vector(module.PARAM_NAMES)
