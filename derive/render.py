@@ -13,6 +13,7 @@ from collections.abc import Iterable
 from pathlib import Path
 
 import jinja2
+from rpr3gen_derive.batch import plan
 from rpr3gen_derive.cse import straight_line
 from rpr3gen_derive.lowering import lower_numpy
 from rpr3gen_derive.printers import c_code, numpy_code
@@ -72,6 +73,7 @@ def render_variant(actuation: str, digest: str | None = None) -> dict[str, str]:
         "assignments": [(str(lhs), numpy_code(rhs)) for lhs, rhs in code.assignments],
         "outputs": [(k, numpy_code(rhs)) for k, (_, rhs) in enumerate(code.outputs)],
         "c_assignments": [(str(lhs), c_code(rhs)) for lhs, rhs in code.assignments],
+        "batch": _c_batch(code, set(inputs), params),
         "c_outputs": [(k, c_code(rhs)) for k, (_, rhs) in enumerate(code.outputs)],
         "conditioning_index": spec.output_names.index("conditioning"),
         "params_doc": PARAM_DOCS,
@@ -86,6 +88,27 @@ def render_variant(actuation: str, digest: str | None = None) -> dict[str, str]:
     return {
         f"{actuation}/{name}": env.get_template(template).render(context)
         for name, template in templates.items()
+    }
+
+
+def _c_batch(code, inputs: set, params: set) -> dict[str, object]:
+    """The three passes of the C batch loop (see :mod:`rpr3gen_derive.batch`), printed."""
+    p = plan(code, inputs, params)
+
+    def lines(statements):
+        return [(str(lhs), c_code(rhs)) for lhs, rhs in statements]
+
+    return {
+        "constants": lines(p.constants),
+        "pass_a": lines(p.pass_a),
+        "pass_b": lines(p.pass_b),
+        "pass_c": lines(p.pass_c),
+        "a_arrays": sorted({str(s) for s in p.a_to_b + p.a_to_c}),
+        "a_to_b": [str(s) for s in p.a_to_b],
+        "a_to_c": [str(s) for s in p.a_to_c],
+        "b_to_c": [str(s) for s in p.b_to_c],
+        "outputs_b": [(k, c_code(e)) for k, e in p.outputs_b],
+        "outputs_c": [(k, c_code(e)) for k, e in p.outputs_c],
     }
 
 

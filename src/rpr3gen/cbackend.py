@@ -25,9 +25,15 @@ import numpy as np
 from rpr3gen.errors import Rpr3genError
 
 CFLAGS: tuple[str, ...] = ("-std=c99", "-O3", "-fPIC", "-shared")
-#: Tried first, for the machine the library is built and used on; dropped if the compiler
-#: refuses it.
-NATIVE: tuple[str, ...] = ("-march=native",)
+#: Extra flags, tried in order until the compiler accepts them: tuned for the machine that
+#: builds and uses the library; gcc's basic-block (SLP) vectoriser off, because with FMA it
+#: fuses multiply-adds differently in the single and the batch function (the batch's loop
+#: vectorisation is unaffected), and the two must agree bit for bit.
+EXTRA_FLAGS: tuple[tuple[str, ...], ...] = (
+    ("-march=native", "-fno-tree-slp-vectorize"),
+    ("-march=native",),
+    (),
+)
 LIBS: tuple[str, ...] = ("-lm",)
 
 #: Built into the library beside the generated C (which it leaves untouched): one pointer for
@@ -87,7 +93,7 @@ def library_path(actuation: str) -> Path:
         for name, text in (("rpr3.c", source), ("rpr3.h", header), ("shim.c", SHIM)):
             (Path(tmp) / name).write_bytes(text)
         built = Path(tmp) / target.name
-        for extra in (NATIVE, ()):
+        for extra in EXTRA_FLAGS:
             result = subprocess.run(
                 [*command, *CFLAGS, *extra, "rpr3.c", "shim.c", "-o", built.name, *LIBS],
                 cwd=tmp,
