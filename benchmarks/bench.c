@@ -21,8 +21,9 @@
  *                       leg the sqrt and the atan2 of the leg vector (3 sqrt, 3 atan2), with the
  *                       few multiply-adds that form their arguments; results are summed into an
  *                       accumulator that is printed, so nothing can be removed
- *   floor_gen_ns        the floor plus the sin and cos of alpha_A, alpha_B, alpha_C, which the
- *                       generated code also evaluates per sample (4 sin, 4 cos, 3 sqrt, 3 atan2)
+ *   floor_gen_ns        the floor plus the sin and cos of alpha_A, alpha_B, alpha_C per sample
+ *                       (4 sin, 4 cos, 3 sqrt, 3 atan2): what parameter trigonometry evaluated
+ *                       per sample costs, as earlier generated code did
  *   single_ns           rpr3_inverse_dynamics called once per sample, out a 51-double buffer
  *   batch_ns            rpr3_inverse_dynamics_batch over all N samples (N x 51 output)
  *   batch_small_ns      rpr3_inverse_dynamics_batch over the first 1000 samples, repeated to
@@ -111,9 +112,9 @@ static double floor_loop(const double *params, size_t n, const double *q)
     return acc;
 }
 
-/* The floor plus the sin and cos of the three alpha parameters per sample, as the generated
- * code evaluates them; "+ 0.0 * phi" keeps the compiler from hoisting them out of the loop
- * (it cannot fold 0.0 * phi under IEEE rules), so each sample pays for them as the kernel does. */
+/* The floor plus the sin and cos of the three alpha parameters per sample; "+ 0.0 * phi" keeps
+ * the compiler from hoisting them out of the loop (it cannot fold 0.0 * phi under IEEE rules),
+ * so each sample pays for them as a kernel that evaluates them per sample would. */
 static double floor_generated_loop(const double *params, size_t n, const double *q)
 {
     const double xA1 = params[0], yA1 = params[1], xB1 = params[2], yB1 = params[3];

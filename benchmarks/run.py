@@ -334,8 +334,16 @@ def worker_lambdify(args: dict[str, Any]) -> dict[str, Any]:
     t_expand = time.perf_counter() - start
     arguments = [syms.params[name] for name in syms.PARAM_NAMES]
     arguments += [*syms.q, *syms.qd, *syms.qdd]
+    # The derivation may use functions of its own (``wrap_angle``); the project's NumPy printer
+    # (SymPy's, plus those) prints them. Everything else is plain lambdify.
+    try:
+        from rpr3gen_derive.printers import NumpyPrinter
+
+        printer: Any = NumpyPrinter()
+    except ImportError:
+        printer = None
     start = time.perf_counter()
-    func = sp.lambdify(arguments, expanded, modules="numpy", cse=False)
+    func = sp.lambdify(arguments, expanded, modules="numpy", cse=False, printer=printer)
     t_lambdify = time.perf_counter() - start
     start = time.perf_counter()
     expanded_ops = sum(int(sp.count_ops(e)) for e in expanded)
@@ -365,11 +373,12 @@ def worker_lambdify(args: dict[str, Any]) -> dict[str, Any]:
             continue
         compared += 1
         row = got[name]
-        got = np.broadcast_to(np.asarray(value, dtype=float), (n,))
+        lam_row = np.broadcast_to(np.asarray(value, dtype=float), (n,))
         scale = max(1.0, float(np.max(np.abs(row))))
-        worst = max(worst, float(np.max(np.abs(got - row))) / scale)
+        worst = max(worst, float(np.max(np.abs(lam_row - row))) / scale)
     return {
         "n": n,
+        "printer": type(printer).__module__ + "." + type(printer).__name__ if printer else None,
         "outputs": len(expanded),
         "compared": compared,
         "derive": t_derive,
@@ -426,7 +435,8 @@ def worker_python_single(args: dict[str, Any]) -> dict[str, Any]:
         "status": status,
         "rejected_status": rejected_status,
         "agree": bool(np.allclose(evaluator.out, slow.out, rtol=1e-9, atol=1e-9)),
-        "cflags": list(cbackend.CFLAGS),
+        # The flags the runtime tries first (it drops extras the compiler refuses).
+        "cflags": [*cbackend.CFLAGS, *cbackend.EXTRA_FLAGS[0]],
         "number": number,
         "repeats": repeats,
     }
@@ -464,7 +474,10 @@ def run_worker(
         return {"error": f"exit status {done.returncode}: {tail}"}
     result = json.loads(lines[-1])
     label = f"{name} " + ", ".join(f"{k}={v}" for k, v in args.items() if k != "mem_limit")
-    CODE_IDS.extend((label.strip(), cid) for cid in result.get("code_ids", []))
+    if env:
+        label += " (" + " ".join(f"{k}={v}" for k, v in env.items()) + ")"
+    if name != "regen":  # regeneration renders from derive/ and does not run generated/
+        CODE_IDS.extend((label.strip(), cid) for cid in result.get("code_ids", []))
     return result
 
 
@@ -1041,10 +1054,11 @@ def section_c(quick: bool) -> tuple[str, dict[str, Any]]:
     rows = [
         ["scalar floor: sin+cos(phi), 3 sqrt, 3 atan2", ns(floor), "1.00x", vec_scalar],
         [
-            "floor + sin, cos of 3 alphas (as generated)",
+            "floor + sin, cos of the 3 alphas",
             ns(values["floor_gen_ns"]),
             ratio(values["floor_gen_ns"] / floor),
-            "same loop plus 3 sin, 3 cos",
+            f"what parameter trigonometry per sample costs; the generated C has "
+            f"{calls.get('sin', 0)} sin, {calls.get('cos', 0)} cos",
         ],
         [
             "C single call `rpr3_inverse_dynamics`",
@@ -1092,6 +1106,7 @@ def section_c(quick: bool) -> tuple[str, dict[str, Any]]:
         prow = [
             [name, f"{100 * share / inside:.0f}%", ns(profiled_ns * share / inside)]
             for name, share in sorted(profile.items(), key=lambda item: -item[1])
+            if share / inside >= 0.005
         ]
         text += (
             "\nWhere the C batch time goes (`perf record` of `bench ... batch`, samples in the "
@@ -1192,7 +1207,14 @@ def section_peers(quick: bool, numpy_results: dict[str, Any]) -> tuple[str, dict
             f"\nThe {lam['outputs']} outputs expanded down to inputs and parameters hold "
             f"{lam['expanded_ops']:,} operations (`sympy.count_ops`), each evaluated as its own "
             f"NumPy operation on the sample arrays (peak RSS of that process "
-            f"{mb(lam['peak_rss'])} MB); {lam['compared']} outputs compared.\n"
+            f"{mb(lam['peak_rss'])} MB); {lam['compared']} outputs compared. "
+            + (
+                f"Printer: `{lam['printer']}` (SymPy's NumPy printer, plus the derivation's own "
+                "functions such as `wrap_angle`)."
+                if lam.get("printer")
+                else "Printer: SymPy's default."
+            )
+            + "\n"
         )
     if "error" in ne:
         text.append(f"Newton-Euler failed: {ne['error']}\n")
