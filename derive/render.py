@@ -115,11 +115,16 @@ def _c_batch(code, inputs: set, params: set) -> dict[str, object]:
 def render(actuations: Iterable[str] = ACTUATIONS) -> dict[str, str]:
     """Every generated file for the given actuation schemes, ``{relative path: text}``."""
     digest = source_hash()
-    files = {
-        "__init__.py": _environment()
-        .get_template("package_init.py.jinja")
-        .render({"source_hash": digest, "actuations": ACTUATIONS})
+    specs = [build_spec(actuation) for actuation in ACTUATIONS]
+    if len({(spec.param_names, spec.output_names) for spec in specs}) != 1:
+        raise ValueError("the actuation variants disagree on their parameter or output names")
+    context = {
+        "source_hash": digest,
+        "actuations": ACTUATIONS,
+        "param_names": specs[0].param_names,
+        "output_names": specs[0].output_names,
     }
+    files = {"__init__.py": _environment().get_template("package_init.py.jinja").render(context)}
     for actuation in actuations:
         files.update(render_variant(actuation, digest))
     return dict(sorted(files.items()))

@@ -13,6 +13,7 @@ from collections.abc import Iterator
 from types import ModuleType
 
 import numpy as np
+import rpr3gen_generated as generated
 from numpy.typing import ArrayLike
 
 from rpr3gen.errors import Rpr3genError
@@ -20,16 +21,9 @@ from rpr3gen.model import Model
 
 BACKENDS: tuple[str, ...] = ("numpy", "c")
 
-_FAMILIES = (
-    "phi10", "lambda21", "phi32", "omega10", "v21", "omega32", "eps10", "gamma21", "eps32",
-    "m10", "f10x", "f10y", "f21y", "f21z", "m21", "f32y", "f32z",
-)  # fmt: skip
 #: Output names, family-major (``phi10_A, phi10_B, phi10_C, lambda21_A, ...``), as conventions.md,
 #: then ``conditioning``: closeness to a parallel singularity, 0 (singular) to 1.
-OUTPUT_NAMES: tuple[str, ...] = (
-    *(f"{f}_{leg}" for f in _FAMILIES for leg in "ABC"),
-    "conditioning",
-)
+OUTPUT_NAMES: tuple[str, ...] = generated.OUTPUT_NAMES
 #: Below this conditioning a pose is singular: its outputs are NaN (as RPR3_MIN_CONDITIONING).
 SINGULAR_CONDITIONING = 1e-9
 #: Samples evaluated per call of the generated code: the NumPy temporaries of one block stay

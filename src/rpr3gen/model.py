@@ -25,21 +25,16 @@ from pathlib import Path
 from typing import Any, NoReturn
 
 import numpy as np
+import rpr3gen_generated as generated
 
 from rpr3gen.errors import ModelError
 
 __all__ = ["ACTUATIONS", "LEGS", "PARAM_NAMES", "Model", "load_model", "model_from_dict"]
 
-PARAM_NAMES: tuple[str, ...] = (
-    "xA1", "yA1", "xB1", "yB1", "xC1", "yC1",
-    "xA3", "yA3", "xB3", "yB3", "xC3", "yC3",
-    "alpha_A", "alpha_B", "alpha_C",
-    "l0", "l2", "c1", "c2", "m1", "m2", "m3", "J1", "J2", "J3",
-    "gx", "gy", "fx", "fy", "mz",
-)  # fmt: skip
+PARAM_NAMES: tuple[str, ...] = generated.PARAM_NAMES
 """Names of the model parameters, in the order of the generated code's ``params`` array."""
 
-ACTUATIONS: tuple[str, ...] = ("revolute", "prismatic")
+ACTUATIONS: tuple[str, ...] = generated.ACTUATIONS
 """Which joint of each leg is driven: the base revolute (the paper) or the prismatic joint."""
 
 LEGS: tuple[str, ...] = ("A", "B", "C")
