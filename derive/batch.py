@@ -92,7 +92,8 @@ def plan(code: StraightLine, inputs: set[sp.Symbol], params: set[sp.Symbol]) -> 
     pass_b = tuple((s, rhs_of[s]) for s in order if s not in early and s not in late)
     b_names = {s for s, _ in pass_b}
 
-    outputs_b, outputs_c = [], []
+    outputs_b: list[tuple[int, sp.Expr]] = []
+    outputs_c: list[tuple[int, sp.Expr]] = []
     for k, (_, expr) in enumerate(code.outputs):
         (outputs_c if expr.free_symbols & late else outputs_b).append((k, expr))
 

@@ -152,15 +152,15 @@ def write_files(out_dir: Path, files: dict[str, str]) -> list[str]:
         for rel in changed:
             target = out_dir / rel
             target.parent.mkdir(parents=True, exist_ok=True)
-            fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", dir=target.parent)
+            fd, name = tempfile.mkstemp(prefix=f".{target.name}.", dir=target.parent)
             with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as handle:
                 handle.write(files[rel])
-            staged.append((rel, Path(tmp)))
-        for rel, tmp in staged:
-            os.replace(tmp, out_dir / rel)
+            staged.append((rel, Path(name)))
+        for rel, temporary in staged:
+            os.replace(temporary, out_dir / rel)
     except BaseException:
-        for _, tmp in staged:
-            tmp.unlink(missing_ok=True)
+        for _, temporary in staged:
+            temporary.unlink(missing_ok=True)
         raise
     return changed
 

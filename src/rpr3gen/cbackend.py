@@ -148,7 +148,7 @@ def names(actuation: str) -> tuple[tuple[str, ...], tuple[str, ...]]:
     for table, macro in (("rpr3_param_names", "RPR3_NUM_PARAMS"),
                          ("rpr3_output_names", "RPR3_NUM_OUTPUTS")):  # fmt: skip
         array = (ctypes.c_char_p * _macro(header, macro)).in_dll(lib, table)
-        tables.append(tuple(item.decode() for item in array))
+        tables.append(tuple((item or b"").decode() for item in array))
     return tables[0], tables[1]
 
 

@@ -362,8 +362,10 @@ class _Reader:
             why = " (the symmetric form needs r and beta_deg)"
             r = self.number(g, "geometry.r", "r", positive=True, why_required=why)
             beta = math.radians(self.number(g, "geometry.beta_deg", "beta_deg", why_required=why))
-            platform = [(r * math.sin(a + beta), -r * math.cos(a + beta)) for a in alpha]
-            base = [
+            platform: list[tuple[float, ...]] = [
+                (r * math.sin(a + beta), -r * math.cos(a + beta)) for a in alpha
+            ]
+            base: list[tuple[float, ...]] = [
                 (px - (l0 + l2) * math.cos(a), py - (l0 + l2) * math.sin(a))
                 for (px, py), a in zip(platform, alpha, strict=True)
             ]
