@@ -57,12 +57,13 @@ def body_motions(kin: LegKinematics) -> tuple[BodyMotion, BodyMotion, BodyMotion
         + 2 * kin.v21 * skew(omega20) * u3
         + kin.gamma21 * u3,
     )
-    # The platform's motion is the input: its point A3 accelerates as eq. (9) found (frame 1),
-    # which equals the chain recursion a32 [gamma_20 + (~w ~w + ~eps)_20 r32] with fewer terms.
+    # The platform's motion is the input: its point A3 accelerates as eq. (9) found, which
+    # equals the chain recursion a32 [gamma_20 + (~w ~w + ~eps)_20 r32]. Frame 3 is parallel to
+    # the platform frame, so a30 = a32 a21 a10 is rot(z, phi), applied directly.
     platform = BodyMotion(
         omega=kin.a32 * piston.omega + kin.omega32 * u3,
         eps=kin.a32 * piston.eps + kin.eps32 * u3,
-        gamma=kin.a32 * kin.a21 * kin.accel_a3,
+        gamma=kin.a30 * kin.accel_a3_world,
     )
     return cyl, piston, platform
 
@@ -106,7 +107,7 @@ def leg_wrenches(prog: Program, kin: LegKinematics, carries_platform: bool) -> L
     cyl, piston, platform = body_motions(kin)
     g1 = kin.a10 * syms.gravity
     g2 = kin.a21 * g1
-    g3 = kin.a32 * g2
+    g3 = kin.a30 * syms.gravity  # = a32 g2, with a30 = a32 a21 a10 = rot(z, phi)
     # Inertia tensors about the joint point; only the component on the rotation axis acts in
     # planar motion (z1 for the cylinder, x2 = -z0 for the piston, z3 for the platform).
     F10, M10 = required_wrench(
@@ -128,7 +129,7 @@ def leg_wrenches(prog: Program, kin: LegKinematics, carries_platform: bool) -> L
             kin.rho,
             sp.diag(0, 0, syms.J3 + syms.m3 * rho2),
             g3,
-            external_force=kin.a32 * kin.a21 * kin.a10 * syms.payload_force,
+            external_force=kin.a30 * syms.payload_force,
             external_moment=syms.payload_moment,  # about z3 = z0
         )
         F3 = prog.define_vector(f"F3_{leg}", F30, step)

@@ -35,6 +35,8 @@ class LegKinematics:
     a32: sp.Matrix
     rho: sp.Matrix  # G - A3 in frame 3 (constant), the paper's r_3^GA
     accel_a3: sp.Matrix  # acceleration of the platform point A3, in frame 1
+    accel_a3_world: sp.Matrix  # the same in the world frame
+    a30: sp.Matrix  # frame 3 from frame 0: rot(z, phi), frame 3 being parallel to the platform
     connectivity: sp.Matrix  # K of eq. (6) written in frame 1: K (omega10, v21, omega32) = rhs
     omega10: sp.Expr
     v21: sp.Expr
@@ -168,6 +170,8 @@ def leg_kinematics(prog: Program, leg: str, cos_phi: sp.Expr, sin_phi: sp.Expr) 
         a32=a32,
         rho=rho,
         accel_a3=accel_a3,
+        accel_a3_world=a_a3,
+        a30=rot_z(cos_phi, sin_phi),
         connectivity=connectivity,
         omega10=omega10,
         v21=v21,
