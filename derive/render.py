@@ -115,6 +115,10 @@ def _c_batch(code, inputs: set, params: set) -> dict[str, object]:
 def render(actuations: Iterable[str] = ACTUATIONS) -> dict[str, str]:
     """Every generated file for the given actuation schemes, ``{relative path: text}``."""
     digest = source_hash()
+    files: dict[str, str] = {}
+    for actuation in actuations:
+        files.update(render_variant(actuation, digest))
+    # The package's name tables hold for every variant (the specs are cached by now).
     specs = [build_spec(actuation) for actuation in ACTUATIONS]
     if len({(spec.param_names, spec.output_names) for spec in specs}) != 1:
         raise ValueError("the actuation variants disagree on their parameter or output names")
@@ -124,9 +128,7 @@ def render(actuations: Iterable[str] = ACTUATIONS) -> dict[str, str]:
         "param_names": specs[0].param_names,
         "output_names": specs[0].output_names,
     }
-    files = {"__init__.py": _environment().get_template("package_init.py.jinja").render(context)}
-    for actuation in actuations:
-        files.update(render_variant(actuation, digest))
+    files["__init__.py"] = _environment().get_template("package_init.py.jinja").render(context)
     return dict(sorted(files.items()))
 
 
