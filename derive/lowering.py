@@ -173,8 +173,12 @@ class _Lowering:
             steps.append(("multiply", coefficient))
         if denominator:
             steps.append(("divide", self._product(denominator)))
-        if not steps:
-            return self.emit(numerator[0], dest)
+        if not steps:  # a lone factor (SymPy folds such a Mul away, but be safe)
+            if dest is None:
+                return acc
+            self.lines.append(f"numpy.copyto({dest}, {acc})")
+            self.release(acc)
+            return dest
         for k, (ufunc, operand) in enumerate(steps):
             final = k == len(steps) - 1
             acc = self.call(ufunc, [acc, operand], dest if final else None)
