@@ -1,13 +1,12 @@
-"""Symbolic derivation of the 3-RPR inverse dynamics (S. Staicu), and its code emission.
+"""Symbolic derivation and code emission for rpr3gen; installed as the package ``rpr3gen_derive``.
 
-This folder is installed as the package ``rpr3gen_derive``. It needs sympy and jinja2 and is
-imported only to regenerate ``generated/`` (``rpr3gen generate``) or to read the derivation in the
-notebooks; the runtime ``rpr3gen`` never imports it.
+It needs sympy and jinja2 and is imported only to regenerate ``generated/`` (``rpr3gen
+generate``) or to read the derivation in the notebooks; the runtime ``rpr3gen`` never imports it.
 
-Layers, one way only: ``symbols`` → ``frames`` → ``kinematics`` → ``dynamics`` →
-``virtual_work`` → ``specs`` → ``cse`` / ``printers`` → ``render`` (templates) → ``generated/``.
+Two halves, one way only:
+
+- ``codegen/``: a generic engine (programs, specs, CSE, one backend per language with its
+  printer and templates, rendering, regeneration check) that imports nothing of the robot;
+- ``rpr3/``: the 3-RPR robot (symbols → frames → kinematics → dynamics → virtual work), its
+  registry of function specs, and ``generate``, which runs the engine on them.
 """
-
-from rpr3gen_derive.specs import ACTUATIONS, FunctionSpec, build_spec
-
-__all__ = ["ACTUATIONS", "FunctionSpec", "build_spec"]

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 import rpr3gen
-from rpr3gen import cbackend
+from rpr3gen import cbackend, manifest
 from rpr3gen.model import Model
 
 ACTUATIONS = ("revolute", "prismatic")
@@ -52,13 +52,30 @@ def _ptr(array: np.ndarray) -> ctypes.c_void_p:
     return ctypes.c_void_p(array.ctypes.data)
 
 
+def _library(actuation: str):
+    """The compiled library of a variant, and its parameter names."""
+    variant = manifest.load(actuation)
+    return cbackend.library(variant).cdll, variant.param_names
+
+
+def _batch(params, q, qd, qdd, actuation: str) -> tuple[np.ndarray, int]:
+    """The generated batch over n samples: row-major outputs and the number that failed."""
+    lib, _ = _library(actuation)
+    q, qd, qdd = (np.ascontiguousarray(a, dtype=np.float64) for a in (q, qd, qdd))
+    rows = np.empty((len(q), len(rpr3gen.OUTPUT_NAMES)))
+    failed = lib.rpr3_inverse_dynamics_batch(
+        _ptr(params), len(q), _ptr(q), _ptr(qd), _ptr(qdd), _ptr(rows)
+    )
+    return rows, int(failed)
+
+
 @pytest.mark.parametrize("actuation", ACTUATIONS)
 def test_single_and_batch_agree_bit_for_bit(actuation: str) -> None:
     _, model, q, qd, qdd = next(c for c in _cases() if c[1].actuation == actuation)
-    params = np.ascontiguousarray(model.vector(cbackend.names(actuation)[0]))
-    rows, failed = cbackend.batch(params, q, qd, qdd, actuation)
+    lib, names = _library(actuation)
+    params = np.ascontiguousarray(model.vector(names))
+    rows, failed = _batch(params, q, qd, qdd, actuation)
     assert failed == 0
-    lib = cbackend.library(actuation)
     out = np.empty(rows.shape[1])
     for i in range(len(q)):
         args = [np.ascontiguousarray(a[i]) for a in (q, qd, qdd)]
@@ -74,8 +91,8 @@ def _singular_sample(model: Model) -> np.ndarray:
 @pytest.mark.parametrize("actuation", ACTUATIONS)
 def test_failure_codes_leave_outputs_untouched(actuation: str) -> None:
     model = _model(ne.paper_params(), actuation)
-    lib = cbackend.library(actuation)
-    params = np.ascontiguousarray(model.vector(cbackend.names(actuation)[0]))
+    lib, names = _library(actuation)
+    params = np.ascontiguousarray(model.vector(names))
     zero = np.zeros(3)
     out = np.full(len(rpr3gen.OUTPUT_NAMES), 7.0)
     for bad, code in (
@@ -90,7 +107,7 @@ def test_failure_codes_leave_outputs_untouched(actuation: str) -> None:
         assert np.all(out == 7.0)
     q = np.array([[0.0, 0.0, 0.0], [0.0, np.nan, 0.0], list(_singular_sample(model)), [0.01, 0, 0]])
     z = np.zeros_like(q)
-    rows, failed = cbackend.batch(params, q, z, z, actuation)
+    rows, failed = _batch(params, q, z, z, actuation)
     assert failed == 2
     assert np.isnan(rows[1]).all()
     assert np.isnan(rows[2]).all()
@@ -150,15 +167,16 @@ def test_build_is_cached_and_rebuilt_when_the_source_changes(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     monkeypatch.setenv("RPR3GEN_CACHE_DIR", str(tmp_path))
-    first = cbackend.library_path("revolute")
+    variant = manifest.load("revolute")
+    first = cbackend.library_path(variant)
     stamp = first.stat().st_mtime_ns
-    assert cbackend.library_path("revolute") == first
+    assert cbackend.library_path(variant) == first
     assert first.stat().st_mtime_ns == stamp  # reused, not rebuilt
-    source, header = cbackend.sources("revolute")
+    source, header = cbackend.sources(variant)
     monkeypatch.setattr(
-        cbackend, "sources", lambda actuation: (source + b"\n/* changed */\n", header)
+        cbackend, "sources", lambda variant: (source + b"\n/* changed */\n", header)
     )
-    second = cbackend.library_path("revolute")
+    second = cbackend.library_path(variant)
     assert second != first
     assert second.is_file()
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted([first.name, second.name])

@@ -10,10 +10,10 @@ import sys
 from pathlib import Path
 
 import pytest
+from rpr3gen_derive.codegen import files
+from rpr3gen_derive.rpr3 import generate
 
 from rpr3gen.cli import main
-
-render = __import__("rpr3gen_derive.render", fromlist=["render"])
 
 
 def test_committed_generated_tree_is_current(
@@ -51,7 +51,7 @@ def test_generate_then_check_round_trip(tmp_path: Path) -> None:
     assert main(["generate", "--out", str(out)]) == 0
     assert main(["generate", "--check", "--out", str(out)]) == 0
     assert sorted(p.relative_to(out).as_posix() for p in out.rglob("*") if p.is_file()) == sorted(
-        render.render()
+        generate.render()
     )
 
 
@@ -85,7 +85,7 @@ def test_output_is_identical_across_hash_seeds(tmp_path: Path) -> None:
 
 
 def test_headers_carry_source_hash_and_nothing_volatile(repo_root: Path) -> None:
-    digest = render.source_hash()
+    digest = generate.source_hash()
     import jinja2
     import sympy
 
@@ -107,11 +107,12 @@ def test_cse_reduces_the_operation_count(repo_root: Path) -> None:
         assert after < before
 
 
-def test_source_hash_follows_the_sources(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+def test_source_hash_follows_the_sources(tmp_path: Path) -> None:
     copy = tmp_path / "derive"
-    shutil.copytree(render.PACKAGE_DIR, copy, ignore=shutil.ignore_patterns("__pycache__"))
-    monkeypatch.setattr(render, "PACKAGE_DIR", copy)
-    monkeypatch.setattr(render, "TEMPLATE_DIR", copy / "templates")
-    original = render.source_hash()
-    (copy / "frames.py").write_text((copy / "frames.py").read_text() + "\n# edit\n")
-    assert render.source_hash() != original
+    shutil.copytree(generate.ROBOT_DIR.parent, copy, ignore=shutil.ignore_patterns("__pycache__"))
+    roots = (copy / "codegen", copy / "rpr3")
+    original = files.source_hash(roots)
+    assert original == generate.source_hash()
+    frames = copy / "rpr3" / "frames.py"
+    frames.write_text(frames.read_text() + "\n# edit\n")
+    assert files.source_hash(roots) != original

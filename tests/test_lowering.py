@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import sympy as sp
-from rpr3gen_derive.cse import StraightLine
-from rpr3gen_derive.lowering import lower_numpy
-from rpr3gen_derive.symbols import wrap_angle
+from rpr3gen_derive.codegen.backends.python.lowering import lower_numpy
+from rpr3gen_derive.codegen.cse import StraightLine
+from rpr3gen_derive.codegen.functions import wrap_angle
 
 a, b = sp.symbols("a b", real=True)  # per-sample inputs
 k, m = sp.symbols("k m", real=True, positive=True)  # parameters

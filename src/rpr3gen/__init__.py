@@ -11,8 +11,8 @@ The runtime imports numpy (and matplotlib for figures) only; regeneration lives 
 ``rpr3gen_derive`` (folder ``derive/``) and writes ``rpr3gen_generated`` (folder ``generated/``).
 """
 
-from rpr3gen.backends import BACKENDS, OUTPUT_NAMES, inverse_dynamics
-from rpr3gen.errors import ModelError, Rpr3genError, TrajectoryError
+from rpr3gen.backends import BACKENDS, OUTPUT_NAMES, evaluate, inverse_dynamics
+from rpr3gen.errors import InputError, ModelError, Rpr3genError, TrajectoryError
 from rpr3gen.model import PARAM_NAMES, Model, load_model
 from rpr3gen.sample import SampleEvaluator
 from rpr3gen.trajectory import Trajectory, paper_trajectory, read_trajectory_csv
@@ -21,12 +21,14 @@ __all__ = [
     "BACKENDS",
     "OUTPUT_NAMES",
     "PARAM_NAMES",
+    "InputError",
     "Model",
     "ModelError",
     "Rpr3genError",
     "SampleEvaluator",
     "Trajectory",
     "TrajectoryError",
+    "evaluate",
     "inverse_dynamics",
     "load_model",
     "paper_trajectory",

@@ -1,59 +1,58 @@
-"""Evaluate the generated inverse dynamics over arrays of samples.
+"""Evaluate generated functions over arrays of samples: the inverse dynamics, and any function by
+name (:func:`evaluate`).
 
-The generated modules live in the package ``rpr3gen_generated`` (folder ``generated/``), one
-sub-package per actuation scheme; this module only shapes arrays and picks the variant.
+This module shapes arrays, picks the model's generated variant (:mod:`rpr3gen.manifest`), runs
+it in blocks through an evaluator (:mod:`rpr3gen.evaluators`) and applies the failure policy
+(:mod:`rpr3gen.policy`), so every backend gives the same NaN rows and return codes.
 """
 
 from __future__ import annotations
 
-import importlib
 import os
 import sys
-from collections.abc import Iterator
-from types import ModuleType
+from collections.abc import Iterator, Sequence
 
 import numpy as np
-import rpr3gen_generated as generated
 from numpy.typing import ArrayLike
 
-from rpr3gen.errors import Rpr3genError
+from rpr3gen import manifest, policy
+from rpr3gen.errors import InputError
+from rpr3gen.evaluators import BACKENDS, evaluator
 from rpr3gen.model import Model
 
-BACKENDS: tuple[str, ...] = ("numpy", "c")
+__all__ = ["BACKENDS", "OUTPUT_NAMES", "evaluate", "inverse_dynamics"]
 
-#: Output names, family-major (``phi10_A, phi10_B, phi10_C, lambda21_A, ...``), as conventions.md,
-#: then ``conditioning``: closeness to a parallel singularity, 0 (singular) to 1.
-OUTPUT_NAMES: tuple[str, ...] = generated.OUTPUT_NAMES
-#: Below this conditioning a pose is singular: its outputs are NaN (as RPR3_MIN_CONDITIONING).
-SINGULAR_CONDITIONING = 1e-9
+#: Output names of the inverse dynamics, family-major (``phi10_A, phi10_B, phi10_C,
+#: lambda21_A, ...``) as conventions.md, then ``conditioning``: closeness to a parallel
+#: singularity, 0 (singular) to 1.
+OUTPUT_NAMES: tuple[str, ...] = (
+    manifest.load(manifest.available()[0]).function("inverse_dynamics").outputs[0].names
+)
 #: Samples evaluated per call of the generated code: the NumPy temporaries of one block stay
 #: in cache and memory stays bounded however long the trajectory (benchmarks/ measures this).
 BLOCK = 8192
+#: Seconds before the progress bar shows (tqdm's ``delay``).
+PROGRESS_DELAY = 0.5
 
 
-def numpy_module(actuation: str) -> ModuleType:
-    """The generated NumPy module of one actuation scheme."""
-    module = importlib.import_module(f"rpr3gen_generated.{actuation}.rpr3_numpy")
-    if tuple(module.OUTPUT_NAMES) != OUTPUT_NAMES:
-        raise Rpr3genError(
-            f"generated code for {actuation!r} does not match this runtime; run `rpr3gen generate`"
-        )
-    return module
-
-
-def _samples(name: str, value: ArrayLike) -> np.ndarray:
-    array = np.asarray(value, dtype=np.float64)
-    if array.ndim == 1 and array.shape == (3,):
+def samples(name: str, value: ArrayLike, size: int) -> np.ndarray:
+    """``value`` as a C-contiguous float64 (n, size) array; one sample may be given as (size,)."""
+    try:
+        array = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"{name} must be an array of numbers: {exc}") from None
+    if array.ndim == 1 and array.shape == (size,):
         array = array[np.newaxis, :]
-    if array.ndim != 2 or array.shape[1] != 3:
-        raise Rpr3genError(f"{name} must have shape (n, 3), got {np.shape(value)}")
+    if array.ndim != 2 or array.shape[1] != size:
+        raise InputError(f"{name} must have shape (n, {size}), got {np.shape(value)}")
     return np.ascontiguousarray(array)
 
 
 def _blocks(n: int, progress: bool) -> Iterator[slice]:
     """Consecutive blocks of at most :data:`BLOCK` samples, with a progress bar on request.
 
-    The bar goes to stderr, only when it is a terminal and the run lasts over half a second.
+    The bar goes to stderr, only when it is a terminal and the run lasts over
+    :data:`PROGRESS_DELAY` seconds.
     """
     starts = range(0, n, BLOCK)
     if progress and sys.stderr.isatty() and n > BLOCK:
@@ -67,7 +66,7 @@ def _blocks(n: int, progress: bool) -> Iterator[slice]:
             total=n,
             unit="sample",
             unit_scale=True,
-            delay=0.5,
+            delay=PROGRESS_DELAY,
             leave=False,
             ncols=size.columns or 80,
             nrows=size.lines or 24,
@@ -81,37 +80,43 @@ def _blocks(n: int, progress: bool) -> Iterator[slice]:
             yield slice(lo, min(lo + BLOCK, n))
 
 
-def _evaluate(
+def evaluate(
     model: Model,
-    q: np.ndarray,
-    qd: np.ndarray,
-    qdd: np.ndarray,
-    backend: str,
+    function: str,
+    inputs: Sequence[ArrayLike],
+    backend: str = "numpy",
     progress: bool = False,
-) -> np.ndarray:
-    """All outputs as a (NUM_OUTPUTS, n) array; rows of a singular sample are inf or nan."""
-    n = q.shape[0]
-    if backend == "numpy":
-        module = numpy_module(model.actuation)
-        params = model.vector(module.PARAM_NAMES)
-        out = np.empty((len(OUTPUT_NAMES), n))
-        for block in _blocks(n, progress):
-            module.rpr3_inverse_dynamics(params, q[block], qd[block], qdd[block], out[:, block])
-        return out
-    if backend == "c":
-        from rpr3gen import cbackend
+) -> tuple[list[np.ndarray], np.ndarray]:
+    """Evaluate the generated function ``function`` of the model's variant over n samples.
 
-        param_names, output_names = cbackend.names(model.actuation)
-        if output_names != OUTPUT_NAMES:
-            raise Rpr3genError("generated C does not match this runtime; run `rpr3gen generate`")
-        params = model.vector(param_names)
-        rows = np.empty((n, len(OUTPUT_NAMES)))
-        for block in _blocks(n, progress):
-            cbackend.batch(
-                params, q[block], qd[block], qdd[block], model.actuation, out=rows[block]
-            )
-        return rows.T
-    raise Rpr3genError(f"unknown backend {backend!r}; choose one of {', '.join(BACKENDS)}")
+    Args:
+        model: the robot; its ``actuation`` (and ``generated`` folder) pick the variant.
+        function: the function's name in the manifest (e.g. ``"inverse_dynamics"``).
+        inputs: one array per input of the function, each (n, size) (or (size,) for one sample).
+        backend: ``"numpy"`` or ``"c"``.
+        progress: show a progress bar on stderr when it is a terminal (long runs).
+
+    Returns:
+        The outputs, each seen as (n, size), and the (n,) return codes (0: ok). The outputs of a
+        failed sample are NaN, whatever the backend.
+    """
+    variant = manifest.load(model.actuation, model.generated)
+    info = variant.function(function)
+    if len(inputs) != len(info.inputs):
+        raise InputError(f"{function} takes {len(info.inputs)} inputs, got {len(inputs)}")
+    arrays = [samples(arg.name, a, arg.size) for arg, a in zip(info.inputs, inputs, strict=True)]
+    if len({a.shape[0] for a in arrays}) != 1:
+        shapes = ", ".join(str(a.shape) for a in arrays)
+        names = ", ".join(arg.name for arg in info.inputs)
+        raise InputError(f"{names} differ in shape: {shapes}")
+    ev = evaluator(variant, backend)
+    params = model.vector(variant.param_names)
+    n = arrays[0].shape[0]
+    outputs = ev.allocate(info, n)
+    for block in _blocks(n, progress):
+        ev.run(info, params, [a[block] for a in arrays], [o[block] for o in outputs])
+    codes = policy.apply(info, arrays, outputs)
+    return outputs, codes
 
 
 def inverse_dynamics(
@@ -134,20 +139,13 @@ def inverse_dynamics(
         progress: show a progress bar on stderr when it is a terminal (long trajectories).
 
     Returns:
-        ``{name: (n,) array}`` for every name of :data:`OUTPUT_NAMES` (conventions.md: loads
-        exerted by body k-1 on body k, SI units). A sample whose input is not finite or whose
-        pose is singular (``conditioning`` under :data:`SINGULAR_CONDITIONING`, or a result
-        not finite) gives NaN in every output, with either backend; no error is raised, so
-        callers decide (``rpr3gen simulate`` refuses such a trajectory). With ``"c"`` the arrays
-        are strided views of one row-major block.
+        ``{name: (n,) array}`` for every name of :data:`OUTPUT_NAMES` (docs/conventions.md:
+        loads exerted by body k-1 on body k, SI units). A sample whose input is not finite or
+        whose pose is singular (``conditioning`` under the generated code's ``MIN_CONDITIONING``,
+        1e-9, or a result not finite) gives NaN in every output, with either backend; no error
+        is raised, so callers decide (``rpr3gen simulate`` refuses such a trajectory). The
+        arrays are views of one block (strided with ``"c"``).
     """
-    q, qd, qdd = _samples("q", q), _samples("qd", qd), _samples("qdd", qdd)
-    if not q.shape == qd.shape == qdd.shape:
-        raise Rpr3genError(f"q, qd, qdd differ in shape: {q.shape}, {qd.shape}, {qdd.shape}")
-    out = _evaluate(model, q, qd, qdd, backend, progress)
-    with np.errstate(invalid="ignore"):
-        singular = ~(out[-1] >= SINGULAR_CONDITIONING) | ~np.isfinite(out).all(axis=0)
-        singular |= ~np.isfinite(np.stack([q, qd, qdd], axis=0)).all(axis=(0, 2))
-    if singular.any():
-        out[:, singular] = np.nan
-    return dict(zip(OUTPUT_NAMES, out, strict=True))
+    (out,), _ = evaluate(model, "inverse_dynamics", (q, qd, qdd), backend, progress)
+    names = manifest.load(model.actuation, model.generated).function("inverse_dynamics")
+    return dict(zip(names.outputs[0].names, out.T, strict=True))

@@ -1,10 +1,16 @@
-"""The ``c`` backend: compile the generated C once, cache it, and call it through ctypes.
+"""The ``c`` backend: compile a generated C variant once, cache it, and bind it through ctypes.
 
 The shared library is built on first use with the system compiler (``$CC`` or ``cc``) into a
 per-user cache folder (``$RPR3GEN_CACHE_DIR``, else ``$XDG_CACHE_HOME/rpr3gen``, else
-``~/.cache/rpr3gen``), named by a SHA-256 of the C sources and the compile command, so a changed
-source is rebuilt and an unchanged one is reused. The build goes to a temporary file renamed
-into place, so concurrent first uses are safe.
+``~/.cache/rpr3gen``), named by a SHA-256 of the C sources, the shim and the compile command, so
+a changed source is rebuilt and an unchanged one is reused. The build goes to a temporary file
+renamed into place, so concurrent first uses are safe.
+
+The binding is derived from the manifest (:mod:`rpr3gen.manifest`): every function takes
+``params``, its inputs and its outputs as pointers, and its batch ``params, n, inputs...,
+outputs...``. A shim compiled beside the generated C (which it leaves untouched) gives each
+function a one-pointer entry ``{name}_packed(void *const *args)``: ctypes then passes one
+argument instead of several, which halves the cost of a call from Python.
 """
 
 from __future__ import annotations
@@ -16,13 +22,12 @@ import shlex
 import shutil
 import subprocess
 import tempfile
-from functools import cache
-from importlib import resources
+from dataclasses import dataclass
 from pathlib import Path
-
-import numpy as np
+from typing import Any
 
 from rpr3gen.errors import Rpr3genError
+from rpr3gen.manifest import Variant
 
 CFLAGS: tuple[str, ...] = ("-std=c99", "-O3", "-fPIC", "-shared")
 #: Extra flags, tried in order until the compiler accepts them: tuned for the machine that
@@ -35,21 +40,6 @@ EXTRA_FLAGS: tuple[tuple[str, ...], ...] = (
     (),
 )
 LIBS: tuple[str, ...] = ("-lm",)
-
-#: Built into the library beside the generated C (which it leaves untouched): one pointer for
-#: ctypes to pass instead of five, which halves the cost of a call from Python.
-SHIM = b"""#include "rpr3.h"
-
-struct rpr3_call {
-    const double *params, *q, *qd, *qdd;
-    double *out;
-};
-
-int rpr3_call_packed(const struct rpr3_call *call)
-{
-    return rpr3_inverse_dynamics(call->params, call->q, call->qd, call->qdd, call->out);
-}
-"""
 
 
 def cache_dir() -> Path:
@@ -70,115 +60,112 @@ def _compiler() -> list[str]:
     return command
 
 
-def sources(actuation: str) -> tuple[bytes, bytes]:
-    """The generated ``rpr3.c`` and ``rpr3.h`` of one actuation scheme."""
-    folder = resources.files("rpr3gen_generated") / actuation
-    return (folder / "rpr3.c").read_bytes(), (folder / "rpr3.h").read_bytes()
+def sources(variant: Variant) -> tuple[bytes, bytes]:
+    """The generated C source and header of a variant."""
+    return variant.path("c_source").read_bytes(), variant.path("c_header").read_bytes()
 
 
-def library_path(actuation: str) -> Path:
-    """Path of the compiled library, building it if it is not in the cache."""
-    source, header = sources(actuation)
+def shim(variant: Variant) -> bytes:
+    """C source of the one-pointer entry points, one per function of the manifest."""
+    lines = [f'#include "{variant.files["c_header"]}"', ""]
+    for f in variant.functions.values():
+        count = 1 + len(f.inputs) + len(f.outputs)
+        args = ", ".join(
+            f"({'const ' if k <= len(f.inputs) else ''}double *)a[{k}]" for k in range(count)
+        )
+        lines += [
+            f"int {f.c_symbol}_packed(void *const *a);",
+            f"int {f.c_symbol}_packed(void *const *a)",
+            "{",
+            f"    return {f.c_symbol}({args});",
+            "}",
+            "",
+        ]
+    return "\n".join(lines).encode()
+
+
+def library_path(variant: Variant) -> Path:
+    """Path of the compiled library of ``variant``, building it if it is not in the cache."""
+    source, header = sources(variant)
+    glue = shim(variant)
     command = _compiler()
     digest = hashlib.sha256()
-    for part in (source, header, SHIM, " ".join(command + list(CFLAGS) + list(LIBS)).encode()):
+    for part in (source, header, glue, " ".join(command + list(CFLAGS) + list(LIBS)).encode()):
         digest.update(part)
         digest.update(b"\0")
     folder = cache_dir()
-    target = folder / f"librpr3_{actuation}_{digest.hexdigest()[:20]}.so"
+    target = folder / f"lib{variant.prefix}_{variant.variant}_{digest.hexdigest()[:20]}.so"
     if target.is_file():
         return target
     folder.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(dir=folder, prefix=".build-") as tmp:
-        for name, text in (("rpr3.c", source), ("rpr3.h", header), ("shim.c", SHIM)):
+        files = {
+            variant.files["c_source"]: source,
+            variant.files["c_header"]: header,
+            "shim.c": glue,
+        }
+        for name, text in files.items():
             (Path(tmp) / name).write_bytes(text)
         built = Path(tmp) / target.name
         for extra in EXTRA_FLAGS:
             result = subprocess.run(
-                [*command, *CFLAGS, *extra, "rpr3.c", "shim.c", "-o", built.name, *LIBS],
+                [*command, *CFLAGS, *extra, variant.files["c_source"], "shim.c", "-o",
+                 built.name, *LIBS],
                 cwd=tmp,
                 capture_output=True,
                 text=True,
                 check=False,
-            )
+            )  # fmt: skip
             if result.returncode == 0:
                 break
         else:
             first = (result.stderr.strip().splitlines() or ["(no message)"])[0]
-            raise Rpr3genError(f"compiling the generated C for {actuation!r} failed: {first}")
+            raise Rpr3genError(f"compiling the generated C of {variant.folder} failed: {first}")
         os.replace(built, target)
     return target
 
 
-@cache
-def library(actuation: str) -> ctypes.CDLL:
-    """The loaded library of one actuation scheme, with typed entry points."""
-    lib = ctypes.CDLL(str(library_path(actuation)))
-    lib.rpr3_inverse_dynamics.restype = ctypes.c_int
-    lib.rpr3_inverse_dynamics.argtypes = [ctypes.c_void_p] * 5
-    lib.rpr3_call_packed.restype = ctypes.c_int
-    lib.rpr3_call_packed.argtypes = [ctypes.c_void_p]
-    lib.rpr3_inverse_dynamics_batch.restype = ctypes.c_size_t
-    lib.rpr3_inverse_dynamics_batch.argtypes = [
-        ctypes.c_void_p,
-        ctypes.c_size_t,
-        ctypes.c_void_p,
-        ctypes.c_void_p,
-        ctypes.c_void_p,
-        ctypes.c_void_p,
-    ]
+@dataclass(frozen=True)
+class Entry:
+    """The typed entry points of one generated function."""
+
+    single: Any  # int f(params, inputs..., outputs...)
+    packed: Any  # int f_packed(void *const *args)
+    batch: Any  # size_t f_batch(params, n, inputs..., outputs...)
+
+
+class Library:
+    """A compiled variant: the ctypes library and its entries by function name."""
+
+    def __init__(self, variant: Variant) -> None:
+        self.variant = variant
+        self.cdll = ctypes.CDLL(str(library_path(variant)))
+        self.entries: dict[str, Entry] = {}
+        for name, f in variant.functions.items():
+            count = len(f.inputs) + len(f.outputs)
+            single = getattr(self.cdll, f.c_symbol)
+            single.restype = ctypes.c_int
+            single.argtypes = [ctypes.c_void_p] * (1 + count)
+            packed = getattr(self.cdll, f"{f.c_symbol}_packed")
+            packed.restype = ctypes.c_int
+            packed.argtypes = [ctypes.c_void_p]
+            batch = getattr(self.cdll, f.c_batch_symbol)
+            batch.restype = ctypes.c_size_t
+            batch.argtypes = [ctypes.c_void_p, ctypes.c_size_t] + [ctypes.c_void_p] * count
+            self.entries[name] = Entry(single, packed, batch)
+
+    def names(self, table: str, size: int) -> tuple[str, ...]:
+        """A C name table (``rpr3_param_names``) of ``size`` entries, read from the library."""
+        array = (ctypes.c_char_p * size).in_dll(self.cdll, table)
+        return tuple((item or b"").decode() for item in array)
+
+
+_LIBRARIES: dict[Path, Library] = {}
+
+
+def library(variant: Variant) -> Library:
+    """The loaded library of ``variant`` (built and loaded once per process and folder)."""
+    lib = _LIBRARIES.get(variant.folder)
+    if lib is None:
+        lib = _LIBRARIES.setdefault(variant.folder, Library(variant))
     return lib
-
-
-class Call(ctypes.Structure):
-    """Arguments of one ``rpr3_inverse_dynamics`` call, for ``rpr3_call_packed``."""
-
-    _fields_ = [(name, ctypes.c_void_p) for name in ("params", "q", "qd", "qdd", "out")]
-
-
-def _macro(header: bytes, name: str) -> int:
-    return int(header.decode().split(f"#define {name} ", 1)[1].split()[0])
-
-
-@cache
-def names(actuation: str) -> tuple[tuple[str, ...], tuple[str, ...]]:
-    """``rpr3_param_names`` and ``rpr3_output_names``, read from the compiled library."""
-    lib, header = library(actuation), sources(actuation)[1]
-    tables = []
-    for table, macro in (("rpr3_param_names", "RPR3_NUM_PARAMS"),
-                         ("rpr3_output_names", "RPR3_NUM_OUTPUTS")):  # fmt: skip
-        array = (ctypes.c_char_p * _macro(header, macro)).in_dll(lib, table)
-        tables.append(tuple((item or b"").decode() for item in array))
-    return tables[0], tables[1]
-
-
-def batch(
-    params: np.ndarray,
-    q: np.ndarray,
-    qd: np.ndarray,
-    qdd: np.ndarray,
-    actuation: str,
-    out: np.ndarray | None = None,
-) -> tuple[np.ndarray, int]:
-    """Evaluate n samples (float64 arrays; q, qd, qdd (n, 3) C-contiguous).
-
-    Args:
-        out: optional C-contiguous (n, NUM_OUTPUTS) array to write into.
-
-    Returns:
-        ``out`` of shape (n, NUM_OUTPUTS), row-major as the C ABI, and the number of failed
-        samples (their rows are NaN).
-    """
-    lib = library(actuation)
-    _, output_names = names(actuation)
-    if out is None:
-        out = np.empty((q.shape[0], len(output_names)))
-    if not out.flags.c_contiguous or out.shape != (q.shape[0], len(output_names)):
-        raise ValueError(f"out must be C-contiguous of shape {(q.shape[0], len(output_names))}")
-    params = np.ascontiguousarray(params, dtype=np.float64)
-    q, qd, qdd = (np.ascontiguousarray(a, dtype=np.float64) for a in (q, qd, qdd))
-    failed = lib.rpr3_inverse_dynamics_batch(
-        params.ctypes.data, q.shape[0], q.ctypes.data, qd.ctypes.data, qdd.ctypes.data,
-        out.ctypes.data,
-    )  # fmt: skip
-    return out, int(failed)

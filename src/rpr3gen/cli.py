@@ -14,11 +14,12 @@ from typing import NoReturn
 
 import numpy as np
 
+from rpr3gen import manifest
 from rpr3gen.backends import BACKENDS, OUTPUT_NAMES, inverse_dynamics
 from rpr3gen.errors import Rpr3genError
-from rpr3gen.model import Model, load_model
+from rpr3gen.model import ACTUATIONS, Model, load_model
+from rpr3gen.policy import DEFAULT_MIN_CONDITIONING, invalid_samples
 from rpr3gen.trajectory import PAPER_TRAJECTORIES, Trajectory, paper_trajectory, read_trajectory_csv
-from rpr3gen.validity import DEFAULT_MIN_CONDITIONING, invalid_samples
 
 EXIT_ERROR = 2
 
@@ -105,7 +106,8 @@ def _screen(
     allow_invalid: bool,
 ) -> None:
     """Refuse a trajectory through an invalid pose, or blank those rows when allowed."""
-    invalid = invalid_samples(model, out, min_conditioning)
+    floor = manifest.load(model.actuation, model.generated).thresholds["MIN_CONDITIONING"]
+    invalid = invalid_samples(model, out, min_conditioning, singular_below=floor)
     if invalid is None:
         return
     if not allow_invalid:
@@ -204,21 +206,22 @@ def _cmd_params(args: argparse.Namespace) -> int:
 
 def _cmd_generate(args: argparse.Namespace) -> int:
     try:
-        from rpr3gen_derive import render
+        from rpr3gen_derive.codegen import files as codegen_files
+        from rpr3gen_derive.rpr3 import generate
     except ImportError as exc:
         raise Rpr3genError(
             f"regeneration needs sympy and jinja2 ({exc.name} is missing): "
             "pip install 'rpr3gen[derive]'"
         ) from exc
-    actuations = render.ACTUATIONS
+    actuations: tuple[str, ...] = ACTUATIONS
     if args.model:
         actuations = (load_model(args.model).actuation,)
-    out_dir = Path(args.out) if args.out else render.default_out_dir()
+    out_dir = Path(args.out) if args.out else generate.default_out_dir()
     if out_dir is None:
         raise Rpr3genError("no source tree's generated/ folder here; name one with --out DIR")
-    files = render.render(actuations)
+    files = generate.render(actuations)
     if args.check:
-        stale = render.stale_files(out_dir, files)
+        stale = codegen_files.stale_files(out_dir, files)
         if stale:
             raise Rpr3genError(
                 f"{out_dir}: stale or edited generated files: {', '.join(stale)}; "
@@ -226,7 +229,7 @@ def _cmd_generate(args: argparse.Namespace) -> int:
             )
         print(f"{out_dir}: {len(files)} generated files up to date")
         return 0
-    changed = render.write_files(out_dir, files)
+    changed = codegen_files.write_files(out_dir, files)
     print(f"{out_dir}: {len(changed)} of {len(files)} files changed")
     return 0
 

@@ -7,7 +7,7 @@ with status 2, without a traceback.
 
 from __future__ import annotations
 
-__all__ = ["ModelError", "Rpr3genError", "TrajectoryError"]
+__all__ = ["InputError", "ModelError", "Rpr3genError", "TrajectoryError"]
 
 
 class Rpr3genError(Exception):
@@ -20,3 +20,7 @@ class ModelError(Rpr3genError):
 
 class TrajectoryError(Rpr3genError):
     """A trajectory file or a trajectory request is malformed."""
+
+
+class InputError(Rpr3genError, ValueError):
+    """An array or option passed to the Python API has a wrong shape or value."""

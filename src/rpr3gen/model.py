@@ -12,6 +12,7 @@ names the file and the dotted key, e.g. ``my.toml: geometry.l0: must be a positi
 
 from __future__ import annotations
 
+import dataclasses
 import difflib
 import importlib.resources
 import json
@@ -25,17 +26,17 @@ from pathlib import Path
 from typing import Any, NoReturn
 
 import numpy as np
-import rpr3gen_generated as generated
 
-from rpr3gen.errors import ModelError
+from rpr3gen import manifest
+from rpr3gen.errors import ModelError, Rpr3genError
 
 __all__ = ["ACTUATIONS", "LEGS", "PARAM_NAMES", "Model", "load_model", "model_from_dict"]
 
-PARAM_NAMES: tuple[str, ...] = generated.PARAM_NAMES
-"""Names of the model parameters, in the order of the generated code's ``params`` array."""
-
-ACTUATIONS: tuple[str, ...] = generated.ACTUATIONS
+ACTUATIONS: tuple[str, ...] = ("revolute", "prismatic")
 """Which joint of each leg is driven: the base revolute (the paper) or the prismatic joint."""
+
+PARAM_NAMES: tuple[str, ...] = manifest.load(ACTUATIONS[0]).param_names
+"""Names of the model parameters, in the order of the generated code's ``params`` array."""
 
 LEGS: tuple[str, ...] = ("A", "B", "C")
 
@@ -100,6 +101,8 @@ class Model:
         source: Where the model came from (a file path or ``"<dict>"``), for messages.
         stroke: Optional piston displacement bounds ``((lo, hi), ...)`` for legs A, B, C (m,
             bounds on lambda21), from ``[limits] stroke``; None when the file sets none.
+        generated: The folder of generated code that evaluates this model (written by
+            ``rpr3gen generate --out DIR``), or None for the installed package.
     """
 
     name: str
@@ -107,6 +110,7 @@ class Model:
     params: Mapping[str, float]
     source: str
     stroke: tuple[tuple[float, float], ...] | None = None
+    generated: str | None = None
 
     def __post_init__(self) -> None:
         if self.actuation not in ACTUATIONS:
@@ -120,6 +124,17 @@ class Model:
             raise ModelError(f"{self.source}: params: missing {missing}, unexpected {extra}")
         ordered = _ReadOnlyParams({n: float(self.params[n]) for n in PARAM_NAMES})
         object.__setattr__(self, "params", ordered)
+        if self.generated is not None:
+            object.__setattr__(self, "generated", os.fspath(self.generated))
+            try:
+                variant = manifest.load(self.actuation, self.generated)
+            except Rpr3genError as exc:
+                raise ModelError(f"generated code: {exc}") from None
+            if variant.param_names != PARAM_NAMES:
+                raise ModelError(
+                    f"{variant.folder}: generated for other model parameters than this "
+                    "runtime's; regenerate it with this version"
+                )
 
     def vector(self, names: Sequence[str] = PARAM_NAMES) -> np.ndarray:
         """Return the parameters ``names`` as a new float64 array of shape ``(len(names),)``.
@@ -130,11 +145,16 @@ class Model:
         return np.array([self.params[n] for n in names], dtype=np.float64)
 
 
-def load_model(path: str | os.PathLike[str] | None = None) -> Model:
+def load_model(
+    path: str | os.PathLike[str] | None = None,
+    generated: str | os.PathLike[str] | None = None,
+) -> Model:
     """Read and validate a model file.
 
     Args:
         path: A TOML model file; ``None`` loads the packaged paper robot (``models/paper.toml``).
+        generated: A folder written by ``rpr3gen generate --out DIR`` whose code evaluates the
+            model; ``None`` uses the installed generated package.
 
     Returns:
         The validated model, with the defaults of ``conventions.md`` filled in.
@@ -165,7 +185,10 @@ def load_model(path: str | os.PathLike[str] | None = None) -> Model:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ModelError(f"{source}: invalid TOML: {_one_line(str(exc))}") from None
-    return model_from_dict(data, source=source)
+    model = model_from_dict(data, source=source)
+    if generated is None:
+        return model
+    return dataclasses.replace(model, generated=os.fspath(generated))
 
 
 def model_from_dict(data: Mapping[str, Any], source: str = "<dict>") -> Model:

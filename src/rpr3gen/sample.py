@@ -5,6 +5,9 @@
 >>> ev()                                       # 0 on success; results in ev.out
 0
 >>> torque = ev.out[ev.index["m10_A"]]
+
+Any generated function can be bound the same way by name (``function="..."``): its inputs and
+outputs become attributes named as in the manifest.
 """
 
 from __future__ import annotations
@@ -14,66 +17,69 @@ import ctypes
 import numpy as np
 from numpy.typing import ArrayLike
 
-from rpr3gen import cbackend
-from rpr3gen.backends import OUTPUT_NAMES, numpy_module
-from rpr3gen.errors import Rpr3genError
+from rpr3gen import manifest, policy
+from rpr3gen.errors import InputError, Rpr3genError
+from rpr3gen.evaluators import evaluator
 from rpr3gen.model import Model
-
-RETURN_CODES = {0: "ok", 1: "an input is not finite", 2: "singular or degenerate pose"}
 
 
 class SampleEvaluator:
-    """Evaluates the inverse dynamics of one sample into preallocated buffers.
+    """Evaluates one sample of a generated function into preallocated buffers.
 
-    Write the sample into :attr:`q`, :attr:`qd`, :attr:`qdd` (float64, shape (3,)) and call the
-    object; the outputs land in :attr:`out` (shape (NUM_OUTPUTS,), ordered as
-    :data:`rpr3gen.OUTPUT_NAMES`; :attr:`index` maps a name to its position). With the ``c``
-    backend a call makes no allocation: the generated C is called with pointers fixed at
-    construction. On a non-zero return code :attr:`out` is left as it was.
+    Write the sample into the input buffers (for the inverse dynamics :attr:`q`, :attr:`qd`,
+    :attr:`qdd`: float64, shape (3,)) and call the object; the outputs land in the output
+    buffers (for the inverse dynamics :attr:`out`, shape (NUM_OUTPUTS,), ordered as
+    :data:`rpr3gen.OUTPUT_NAMES`; :attr:`index` maps a name of the first output to its
+    position). With the ``c`` backend a call makes no allocation: the generated C is called
+    with pointers fixed at construction. On a non-zero return code the outputs are left as they
+    were; :attr:`codes` maps each code to its meaning (from the manifest).
     """
 
-    def __init__(self, model: Model, backend: str = "c") -> None:
+    def __init__(self, model: Model, backend: str = "c", function: str = "inverse_dynamics"):
         self.model = model
         self.backend = backend
-        self.q = np.zeros(3)
-        self.qd = np.zeros(3)
-        self.qdd = np.zeros(3)
-        self.out = np.full(len(OUTPUT_NAMES), np.nan)
-        self.index = {name: k for k, name in enumerate(OUTPUT_NAMES)}
+        variant = manifest.load(model.actuation, model.generated)
+        self.function = variant.function(function)
+        self.codes = dict(variant.code_meanings)
+        self.params = np.ascontiguousarray(model.vector(variant.param_names))
+        self.inputs = {a.name: np.zeros(a.size) for a in self.function.inputs}
+        self.outputs = {o.name: np.full(o.size, np.nan) for o in self.function.outputs}
+        for name, buffer in (*self.inputs.items(), *self.outputs.items()):
+            setattr(self, name, buffer)
+        first = self.function.outputs[0]
+        self.index = {name: k for k, name in enumerate(first.names)}
+        ev = evaluator(variant, backend)  # also checks the backend's name
         if backend == "c":
-            param_names, output_names = cbackend.names(model.actuation)
-            if output_names != OUTPUT_NAMES:
-                raise Rpr3genError("generated C does not match this runtime; run rpr3gen generate")
-            self.params = np.ascontiguousarray(model.vector(param_names))
-            buffers = (self.params, self.q, self.qd, self.qdd, self.out)
-            self._packed = cbackend.Call(*(b.ctypes.data for b in buffers))
-            self._args = (ctypes.c_void_p(ctypes.addressof(self._packed)),)
-            self._call = cbackend.library(model.actuation).rpr3_call_packed
-        elif backend == "numpy":
-            module = numpy_module(model.actuation)
-            self.params = model.vector(module.PARAM_NAMES)
-            self._numpy = module.rpr3_inverse_dynamics
-            self._scratch = np.empty((len(OUTPUT_NAMES), 1))
+            buffers = [self.params, *self.inputs.values(), *self.outputs.values()]
+            self._pointers = (ctypes.c_void_p * len(buffers))(*(b.ctypes.data for b in buffers))
+            self._args = (ctypes.c_void_p(ctypes.addressof(self._pointers)),)
+            self._call = ev.library.entries[self.function.name].packed  # type: ignore[attr-defined]
         else:
-            raise Rpr3genError(f"unknown backend {backend!r}; choose c or numpy")
+            self._evaluator = ev
+            self._scratch = ev.allocate(self.function, 1)
 
     def __call__(self) -> int:
-        """Evaluate the sample in q, qd, qdd; return 0, or a code of :data:`RETURN_CODES`."""
+        """Evaluate the sample in the input buffers; return 0, or a code of :attr:`codes`."""
         if self.backend == "c":
-            return self._call(*self._args)
-        inputs = (self.q, self.qd, self.qdd)
-        if not all(np.isfinite(v).all() for v in inputs):
-            return 1
-        self._numpy(self.params, *(v[np.newaxis, :] for v in inputs), self._scratch)
-        if not np.isfinite(self._scratch).all():
-            return 2
-        self.out[:] = self._scratch[:, 0]
-        return 0
+            return int(self._call(*self._args))
+        inputs = [v[np.newaxis, :] for v in self.inputs.values()]
+        self._evaluator.run(self.function, self.params, inputs, self._scratch)
+        code = int(policy.return_codes(self.function, inputs, self._scratch)[0])
+        if code == 0:
+            for out, scratch in zip(self.outputs.values(), self._scratch, strict=True):
+                out[:] = scratch[0]
+        return code
 
-    def evaluate(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> np.ndarray:
-        """Copy a sample in, evaluate, and return :attr:`out`; raise on a non-zero code."""
-        self.q[:], self.qd[:], self.qdd[:] = q, qd, qdd
+    def evaluate(self, *inputs: ArrayLike) -> np.ndarray:
+        """Copy a sample in, evaluate, and return the first output; raise on a non-zero code."""
+        if len(inputs) != len(self.inputs):
+            raise InputError(f"{self.function.name} takes {len(self.inputs)} inputs")
+        for buffer, value in zip(self.inputs.values(), inputs, strict=True):
+            buffer[:] = value
         status = self()
         if status:
-            raise Rpr3genError(f"sample q={self.q.tolist()}: {RETURN_CODES.get(status, status)}")
-        return self.out
+            first = next(iter(self.inputs))
+            raise Rpr3genError(
+                f"sample {first}={self.inputs[first].tolist()}: {self.codes.get(status, status)}"
+            )
+        return next(iter(self.outputs.values()))

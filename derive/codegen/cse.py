@@ -1,21 +1,23 @@
-"""Common subexpression elimination over a derivation program, deterministically ordered.
+"""Common subexpression elimination over a program, deterministically ordered.
 
-The program's right-hand sides and the outputs are passed to ``sympy.cse`` together, in program
-order, with ``order="canonical"``; the result is a straight-line list of assignments in which
-every temporary comes right before its first use. Assignments that no output needs are dropped.
+The program's right-hand sides and a function's outputs are passed to ``sympy.cse`` together,
+in program order, with ``order="canonical"``; the result is a straight-line list of assignments
+in which every temporary comes right before its first use. Assignments that no output needs are
+dropped.
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import sympy as sp
-from rpr3gen_derive.specs import FunctionSpec
+from rpr3gen_derive.codegen.program import Program
 
 
 @dataclass(frozen=True)
 class StraightLine:
-    """Code ready to print: ``assignments`` in order, then ``outputs`` (name, expression)."""
+    """Code ready to print: ``assignments`` in order, then ``outputs`` (label, expression)."""
 
     assignments: tuple[tuple[sp.Symbol, sp.Expr], ...]
     outputs: tuple[tuple[str, sp.Expr], ...]
@@ -28,13 +30,15 @@ def count_ops(exprs: list[sp.Expr]) -> int:
     return sum(int(sp.count_ops(e)) for e in exprs)
 
 
-def _live(spec: FunctionSpec) -> list[tuple[sp.Symbol, sp.Expr]]:
+def _live(
+    program: Program, outputs: Sequence[tuple[str, sp.Expr]]
+) -> list[tuple[sp.Symbol, sp.Expr]]:
     """The program's assignments that some output depends on, in program order."""
     needed: set[sp.Symbol] = set()
-    for _, expr in spec.outputs:
+    for _, expr in outputs:
         needed |= expr.free_symbols
     live = []
-    for a in reversed(spec.program.assignments):
+    for a in reversed(program.assignments):
         if a.symbol in needed:
             live.append((a.symbol, a.expr))
             needed |= a.expr.free_symbols
@@ -42,10 +46,10 @@ def _live(spec: FunctionSpec) -> list[tuple[sp.Symbol, sp.Expr]]:
     return live
 
 
-def straight_line(spec: FunctionSpec) -> StraightLine:
-    """Eliminate common subexpressions across the whole program of ``spec``."""
-    live = _live(spec)
-    exprs = [expr for _, expr in live] + [expr for _, expr in spec.outputs]
+def straight_line(program: Program, outputs: Sequence[tuple[str, sp.Expr]]) -> StraightLine:
+    """Eliminate common subexpressions across ``program`` and the ``(label, expr)`` outputs."""
+    live = _live(program, outputs)
+    exprs = [expr for _, expr in live] + [expr for _, expr in outputs]
     ops_before = count_ops(exprs)
     temporaries, reduced = sp.cse(
         exprs, symbols=sp.numbered_symbols("x", real=True), order="canonical"
@@ -65,9 +69,9 @@ def straight_line(spec: FunctionSpec) -> StraightLine:
     for (sym, _), expr in zip(live, reduced[: len(live)], strict=True):
         emit_temps_of(expr)
         lines.append((sym, expr))
-    outputs = []
-    for (name, _), expr in zip(spec.outputs, reduced[len(live) :], strict=True):
+    result = []
+    for (name, _), expr in zip(outputs, reduced[len(live) :], strict=True):
         emit_temps_of(expr)
-        outputs.append((name, expr))
-    ops_after = count_ops([expr for _, expr in lines] + [expr for _, expr in outputs])
-    return StraightLine(tuple(lines), tuple(outputs), ops_before, ops_after)
+        result.append((name, expr))
+    ops_after = count_ops([expr for _, expr in lines] + [expr for _, expr in result])
+    return StraightLine(tuple(lines), tuple(result), ops_before, ops_after)

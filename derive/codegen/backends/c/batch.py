@@ -3,8 +3,8 @@
 Calls into libm (sin, cos, sqrt, atan2, nearbyint) keep a loop scalar. The batch function
 therefore evaluates a block of samples in three passes:
 
-A. scalar, per sample: the statements that call libm early (the pose: sin/cos of phi, the leg
-   lengths and angles) and what they depend on; their results go to block arrays;
+A. scalar, per sample: the statements that call libm early (in a robot: the pose, sin/cos of an
+   angle, lengths and angles) and what they depend on; their results go to block arrays;
 B. per sample, arithmetic only: everything else, in a loop with no calls, which the compiler
    vectorises across samples (structure of arrays, no aliasing);
 C. scalar, per sample: the few late calls (the square root of the conditioning), the validity
@@ -16,7 +16,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import sympy as sp
-from rpr3gen_derive.cse import StraightLine
+from rpr3gen_derive.codegen.cse import StraightLine
 
 #: A call whose dependencies number more than this is late (pass C), not early (pass A).
 EARLY_LIMIT = 20

@@ -32,11 +32,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import sympy as sp
-from rpr3gen_derive import symbols as syms
-from rpr3gen_derive.dynamics import LegWrenches
-from rpr3gen_derive.frames import skew, u1, u2, u3
-from rpr3gen_derive.kinematics import LegKinematics
-from rpr3gen_derive.symbols import Program
+from rpr3gen_derive.codegen.program import Program
+from rpr3gen_derive.rpr3 import symbols as syms
+from rpr3gen_derive.rpr3.dynamics import LegWrenches
+from rpr3gen_derive.rpr3.frames import skew, u1, u2, u3
+from rpr3gen_derive.rpr3.kinematics import LegKinematics
 
 STEP_CLOSURE = "closure of the virtual motions, eq. (7)"
 STEP_VIRTUAL = "characteristic virtual velocities, eqs. (7)-(8)"

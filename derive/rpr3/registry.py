@@ -1,20 +1,35 @@
-"""The one source of truth for each generated function: ordered inputs, outputs, docstring.
+"""The 3-RPR's registry of generated functions: one spec builder per function, per variant.
 
-The NumPy module, the C header and source, their name tables and the documentation are all
-rendered from a :class:`FunctionSpec`.
+Each entry of :data:`FUNCTIONS` turns an actuation scheme into a
+:class:`~rpr3gen_derive.codegen.spec.FunctionSpec`; :func:`module` gathers them, with the
+parameter vector, return codes and thresholds they share, into the
+:class:`~rpr3gen_derive.codegen.spec.ModuleSpec` of one variant (one folder of ``generated/``).
+Adding a generated function is adding an entry here.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from functools import cache
 
 import sympy as sp
-from rpr3gen_derive import symbols as syms
-from rpr3gen_derive.dynamics import leg_wrenches
-from rpr3gen_derive.kinematics import leg_kinematics, platform_rotation
-from rpr3gen_derive.symbols import LEGS, PARAM_NAMES, Program
-from rpr3gen_derive.virtual_work import joint_loads
+from rpr3gen_derive.codegen.program import Program
+from rpr3gen_derive.codegen.spec import (
+    Argument,
+    Check,
+    Component,
+    FunctionSpec,
+    ModuleSpec,
+    Output,
+    ReturnCode,
+    Threshold,
+)
+from rpr3gen_derive.rpr3 import symbols as syms
+from rpr3gen_derive.rpr3.dynamics import leg_wrenches
+from rpr3gen_derive.rpr3.kinematics import leg_kinematics, platform_rotation
+from rpr3gen_derive.rpr3.symbols import LEGS, PARAM_NAMES
+from rpr3gen_derive.rpr3.virtual_work import joint_loads
 
 ACTUATIONS: tuple[str, ...] = ("revolute", "prismatic")
 
@@ -99,23 +114,6 @@ OUTPUT_DOCS: tuple[tuple[str, str, str], ...] = tuple(
 ) + tuple((f.name, f.unit, f.meaning) for f in SAMPLE_OUTPUTS)
 
 
-@dataclass(frozen=True)
-class FunctionSpec:
-    """A generated function: ``outputs = f(params, q, qd, qdd)``, as a program of assignments."""
-
-    name: str
-    actuation: str
-    param_names: tuple[str, ...]
-    inputs: tuple[tuple[str, tuple[sp.Symbol, ...]], ...]  # ("q", (x, y, phi)), ...
-    program: Program
-    outputs: tuple[tuple[str, sp.Expr], ...]  # (name, expression in program symbols)
-    docstring: str
-
-    @property
-    def output_names(self) -> tuple[str, ...]:
-        return tuple(name for name, _ in self.outputs)
-
-
 def derive(actuation: str) -> tuple[Program, dict[str, sp.Expr]]:
     """Run the paper's algorithm (steps 1-9) symbolically; return the program and outputs."""
     if actuation not in ACTUATIONS:
@@ -139,9 +137,71 @@ def derive(actuation: str) -> tuple[Program, dict[str, sp.Expr]]:
     return prog, {name: values[name] for name in OUTPUT_NAMES}
 
 
-@cache
-def build_spec(actuation: str) -> FunctionSpec:
-    """The spec of ``rpr3_inverse_dynamics`` for one actuation scheme."""
+PREFIX = "rpr3"
+
+PARAMS = Argument(
+    name="params",
+    symbols=tuple(syms.params[name] for name in PARAM_NAMES),
+    components=tuple(Component(name, unit, meaning) for name, unit, meaning in PARAM_DOCS),
+    doc="model parameters",
+    table="param_names",
+)
+
+POSE = Argument(
+    "q",
+    tuple(syms.q),
+    (
+        Component("x", "m", "platform centre G, world x0"),
+        Component("y", "m", "platform centre G, world y0"),
+        Component("phi", "rad", "platform rotation from the central configuration"),
+    ),
+    "platform centre G in the world frame (m), platform angle (rad)",
+)
+VELOCITY = Argument(
+    "qd",
+    tuple(syms.qd),
+    tuple(Component(f"d{c.name}", f"{c.unit}/s", f"d({c.name})/dt") for c in POSE.components),
+    "its time derivative (m/s, rad/s)",
+)
+ACCELERATION = Argument(
+    "qdd",
+    tuple(syms.qdd),
+    tuple(Component(f"dd{c.name}", f"{c.unit}/s^2", f"d2({c.name})/dt2") for c in POSE.components),
+    "its second time derivative (m/s^2, rad/s^2)",
+)
+
+RETURN_CODES: tuple[ReturnCode, ...] = (
+    ReturnCode("OK", 0, "success"),
+    ReturnCode("NOT_FINITE", 1, "an input is NaN or infinite"),
+    ReturnCode(
+        "SINGULAR",
+        2,
+        "singular or degenerate pose: conditioning below the floor below, or a result that "
+        "would not be finite",
+    ),
+)
+
+THRESHOLDS: tuple[Threshold, ...] = (
+    Threshold(
+        "MIN_CONDITIONING",
+        "1e-9",
+        'Output "conditioning" (0 at a parallel singularity, 1 at best) under which a pose '
+        "counts as singular: the loads there are dominated by round-off. Applications usually "
+        "want a larger margin of their own (rpr3gen simulate refuses poses under 1e-3 by "
+        "default).",
+    ),
+)
+
+#: The failure conditions of a function of the pose, in the order they are tested.
+SINGULAR_POSE_CHECKS: tuple[Check, ...] = (
+    Check("inputs_not_finite", "NOT_FINITE"),
+    Check("below", "SINGULAR", "out", "conditioning", "MIN_CONDITIONING"),
+    Check("outputs_not_finite", "SINGULAR"),
+)
+
+
+def inverse_dynamics(actuation: str) -> FunctionSpec:
+    """``rpr3_inverse_dynamics``: leg kinematics and every joint load (eqs. 5-17)."""
     prog, outputs = derive(actuation)
     actuated = "m10 at A1 (f21z = 0)" if actuation == "revolute" else "f21z at A2 (m10 = 0)"
     doc = (
@@ -150,15 +210,51 @@ def build_spec(actuation: str) -> FunctionSpec:
         "(eqs. 12-17) from the platform pose q = (x, y, phi), its velocity qd and acceleration qdd."
     )
     return FunctionSpec(
-        name="rpr3_inverse_dynamics",
-        actuation=actuation,
-        param_names=PARAM_NAMES,
-        inputs=(
-            ("q", tuple(syms.q)),
-            ("qd", tuple(syms.qd)),
-            ("qdd", tuple(syms.qdd)),
+        name="inverse_dynamics",
+        doc=doc,
+        inputs=(POSE, VELOCITY, ACCELERATION),
+        outputs=(
+            Output(
+                "out",
+                tuple(outputs.values()),
+                tuple(Component(name, unit, meaning) for name, unit, meaning in OUTPUT_DOCS),
+                "row k receives OUTPUT_NAMES[k] (loads: exerted by body k-1 on body k); the rows "
+                "of a singular pose hold inf or nan",
+                table="output_names",
+            ),
         ),
         program=prog,
-        outputs=tuple(outputs.items()),
-        docstring=doc,
+        checks=SINGULAR_POSE_CHECKS,
+    )
+
+
+FunctionBuilder = Callable[[str], FunctionSpec]
+
+#: Every generated function, by name: a builder from the actuation scheme to its spec.
+FUNCTIONS: Mapping[str, FunctionBuilder] = {"inverse_dynamics": inverse_dynamics}
+
+
+@cache
+def _spec(builder: FunctionBuilder, actuation: str) -> FunctionSpec:
+    return builder(actuation)
+
+
+def module(actuation: str, functions: Mapping[str, FunctionBuilder] | None = None) -> ModuleSpec:
+    """The generated module of one actuation scheme: every function of ``functions``."""
+    if actuation not in ACTUATIONS:
+        raise ValueError(f"actuation must be one of {ACTUATIONS}, got {actuation!r}")
+    functions = FUNCTIONS if functions is None else functions
+    return ModuleSpec(
+        prefix=PREFIX,
+        variant=actuation,
+        doc=(
+            f"Generated functions of the 3-RPR planar parallel robot (S. Staicu), {actuation} "
+            "actuation. Model numbers are inputs (params), so one build serves every robot of "
+            "this structure."
+        ),
+        params=PARAMS,
+        functions=tuple(_spec(builder, actuation) for builder in functions.values()),
+        return_codes=RETURN_CODES,
+        thresholds=THRESHOLDS,
+        defines=(("ACTUATION", f'"{actuation}"', ""),),
     )

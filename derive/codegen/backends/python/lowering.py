@@ -12,9 +12,9 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import sympy as sp
-from rpr3gen_derive.cse import StraightLine
-from rpr3gen_derive.printers import INV_TWO_PI, TWO_PI, numpy_code
-from rpr3gen_derive.symbols import wrap_angle
+from rpr3gen_derive.codegen.backends.python.printer import numpy_code
+from rpr3gen_derive.codegen.cse import StraightLine
+from rpr3gen_derive.codegen.functions import INV_TWO_PI, TWO_PI, wrap_angle
 
 _UFUNC = {sp.cos: "cos", sp.sin: "sin", sp.Abs: "absolute", sp.atan2: "arctan2"}
 

@@ -9,9 +9,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import sympy as sp
-from rpr3gen_derive import symbols as syms
-from rpr3gen_derive.frames import leg_matrices, rot_z, skew, u3
-from rpr3gen_derive.symbols import Program
+from rpr3gen_derive.codegen.program import Program
+from rpr3gen_derive.rpr3 import symbols as syms
+from rpr3gen_derive.rpr3.frames import leg_matrices, rot_z, skew, u3
 
 STEP_POSE = "inverse kinematics, eq. (5)"
 STEP_VELOCITY = "connectivity conditions and velocities, eq. (6)"

@@ -1,0 +1,165 @@
+"""The C99 backend: a header and a source per variant, needing only ``<math.h>``, ``<stddef.h>``.
+
+Per function ``f`` of a module with prefix ``p``: ``int p_f(params, inputs..., outputs...)`` for
+one sample (outputs untouched unless it returns ``P_OK``) and ``size_t p_f_batch(params, n,
+inputs..., outputs...)`` over n row-major samples, evaluated in three passes so that the
+compiler vectorises the arithmetic (:mod:`.batch`). Both run the same statements.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+import jinja2
+from rpr3gen_derive.codegen.backends.c.batch import plan
+from rpr3gen_derive.codegen.backends.c.printer import c_code
+from rpr3gen_derive.codegen.spec import ModuleSpec
+
+if TYPE_CHECKING:
+    from rpr3gen_derive.codegen.render import Compiled, Stage
+
+
+WIDTH = 100
+
+
+def signature(head: str, params: list[str], tail: str = "") -> str:
+    """A C declarator ``head(p1, p2, ...)tail`` wrapped at :data:`WIDTH`, aligned on ``(``."""
+    indent = " " * (len(head) + 1)
+    lines = [f"{head}("]
+    for k, param in enumerate(params):
+        text = param + ("," if k < len(params) - 1 else ")" + tail)
+        if lines[-1].endswith("(") or len(lines[-1]) + 1 + len(text) <= WIDTH:
+            lines[-1] += ("" if lines[-1].endswith("(") else " ") + text
+        else:
+            lines.append(indent + text)
+    return "\n".join(lines)
+
+
+def comment(text: str, first: str, rest: str, width: int = WIDTH - 4) -> str:
+    """``text`` as lines of a C block comment: ``first`` before the first, ``rest`` the others."""
+    words, lines = text.split(), [first]
+    for word in words:
+        if len(lines[-1]) + 1 + len(word) > width and lines[-1].strip(" *"):
+            lines.append(rest)
+        lines[-1] += ("" if lines[-1].endswith(" ") else " ") + word
+    return "\n".join(lines)
+
+
+def _lines(statements: Any) -> list[tuple[str, str]]:
+    return [(str(lhs), c_code(rhs)) for lhs, rhs in statements]
+
+
+def _function(module: ModuleSpec, c: Compiled) -> dict[str, Any]:
+    """Template context of one function."""
+    from rpr3gen_derive.codegen.render import table_count
+
+    prefix, spec = module.prefix, c.spec
+    upper = prefix.upper()
+    params = {s for s in module.params.symbols if any(str(s) == n for _, n in c.used_params)}
+    p = plan(c.code, c.input_symbols, params)
+    slot = dict(enumerate(c.slots))
+
+    def outputs(indexed: Any) -> list[tuple[str, int, str]]:
+        return [(*slot[k], c_code(e)) for k, e in indexed]
+
+    sizes = {
+        o.name: f"{upper}_{table_count(o.table)}" if o.table else str(o.size) for o in spec.outputs
+    }
+    name = f"{prefix}_{spec.name}"
+    single = ["const double *params"]
+    single += [f"const double {a.name}[{a.size}]" for a in spec.inputs]
+    single += [f"double {o.name}[{sizes[o.name]}]" for o in spec.outputs]
+    batch = ["const double *params", "size_t n"]
+    batch += [f"const double *{a.name}" for a in spec.inputs]
+    batch += [f"double *{o.name}" for o in spec.outputs]
+    kernel = ["const double *restrict params"]
+    kernel += [f"const double *restrict {a.name}" for a in spec.inputs]
+    kernel += [f"double *restrict r_{o.name}" for o in spec.outputs]
+    checks = []
+    input_code = None
+    for check in spec.checks:
+        code = f"{upper}_{check.code}"
+        if check.kind == "inputs_not_finite":
+            input_code = code
+        elif check.kind == "below":
+            out = spec.output(str(check.output))
+            index = [comp.name for comp in out.components].index(str(check.component))
+            checks.append(
+                {
+                    "kind": "below",
+                    "code": code,
+                    "output": out.name,
+                    "index": index,
+                    "threshold": f"{upper}_{check.threshold}",
+                }
+            )
+        else:
+            checks.append({"kind": check.kind, "code": code})
+    return {
+        "spec": spec,
+        "name": name,
+        "single": signature(f"int {name}", single),
+        "batch_signature": signature(f"size_t {name}_batch", batch),
+        "kernel": signature(f"static int {name}_kernel", kernel),
+        "sizes": sizes,
+        "used_params": c.used_params,
+        "used_inputs": c.used_inputs,
+        "assignments": _lines(c.code.assignments),
+        "outputs": outputs(enumerate(e for _, e in c.code.outputs)),
+        "input_code": input_code,
+        "checks": checks,
+        "ops_before": c.code.ops_before,
+        "ops_after": c.code.ops_after,
+        "batch": {
+            "constants": _lines(p.constants),
+            "pass_a": _lines(p.pass_a),
+            "pass_b": _lines(p.pass_b),
+            "pass_c": _lines(p.pass_c),
+            "a_arrays": sorted({str(s) for s in p.a_to_b + p.a_to_c}),
+            "a_to_b": [str(s) for s in p.a_to_b],
+            "a_to_c": [str(s) for s in p.a_to_c],
+            "b_to_c": [str(s) for s in p.b_to_c],
+            "outputs_b": outputs(p.outputs_b),
+            "outputs_c": outputs(p.outputs_c),
+        },
+    }
+
+
+def render(
+    module: ModuleSpec,
+    compiled: list[Compiled],
+    digest: str,
+    env: jinja2.Environment,
+    stage: Stage,
+) -> dict[str, tuple[str, str]]:
+    """``{"c_header": (name, text), "c_source": (name, text)}`` of one module."""
+    from rpr3gen_derive.codegen.render import table_count
+
+    with stage("print"):
+        functions = [_function(module, c) for c in compiled]
+    tables = [(table_count(module.params.table or "param_names"), module.params)]
+    for c in compiled:
+        tables += [(table_count(o.table), o) for o in c.spec.outputs if o.table]
+    uses_finite = any(f["input_code"] or f["checks"] for f in functions)
+    context = {
+        "module": module,
+        "functions": functions,
+        "tables": tables,
+        "source_hash": digest,
+        "upper": module.prefix.upper(),
+        "prefix": module.prefix,
+        "uses_finite": uses_finite,
+        "ops_before": sum(f["ops_before"] for f in functions),
+        "ops_after": sum(f["ops_after"] for f in functions),
+        "assignments": sum(len(f["assignments"]) for f in functions),
+    }
+    with stage("render"):
+        header = env.get_template("backends/c/templates/header.h.jinja").render(context)
+        source = env.get_template("backends/c/templates/source.c.jinja").render(context)
+    return {
+        "c_header": (f"{module.prefix}.h", header),
+        "c_source": (f"{module.prefix}.c", source),
+    }
+
+
+__all__ = ["render"]

@@ -1,0 +1,63 @@
+"""The NumPy backend: one module ``{prefix}_numpy.py`` per variant, needing only numpy.
+
+Each function is lowered to ufunc calls into reused buffers (:mod:`.lowering`) and takes
+``params`` (P,), its inputs as (n, size) arrays and writes its outputs into (size, n) arrays.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import jinja2
+from rpr3gen_derive.codegen.backends.python.lowering import lower_numpy
+from rpr3gen_derive.codegen.spec import ModuleSpec
+
+if TYPE_CHECKING:
+    from rpr3gen_derive.codegen.render import Compiled, Stage
+
+
+def render(
+    module: ModuleSpec,
+    compiled: list[Compiled],
+    digest: str,
+    env: jinja2.Environment,
+    stage: Stage,
+) -> dict[str, tuple[str, str]]:
+    """``{"numpy": (file name, text)}`` of one module."""
+    from rpr3gen_derive.codegen.render import table_count
+
+    functions = []
+    with stage("print"):
+        for c in compiled:
+            inputs = {s: str(s) for arg in c.spec.inputs for s in arg.symbols}
+            params = {
+                s for s in module.params.symbols if any(str(s) == n for _, n in c.used_params)
+            }
+            rows = {f"{o}[{k}]": f"{o}[{k}]" for o, k in c.slots}
+            functions.append(
+                {
+                    "c": c,
+                    "spec": c.spec,
+                    "name": f"{module.prefix}_{c.spec.name}",
+                    "lowered": lower_numpy(c.code, inputs, params, rows),
+                    "first_input": c.spec.inputs[0].name,
+                    "sizes": {
+                        o.name: table_count(o.table) if o.table else str(o.size)
+                        for o in c.spec.outputs
+                    },
+                }
+            )
+    tables = [(table_count(module.params.table or "param_names"), module.params)]
+    for c in compiled:
+        tables += [(table_count(o.table), o) for o in c.spec.outputs if o.table]
+    with stage("render"):
+        text = env.get_template("backends/python/templates/module.py.jinja").render(
+            module=module,
+            functions=functions,
+            tables=tables,
+            source_hash=digest,
+            ops_before=sum(c.code.ops_before for c in compiled),
+            ops_after=sum(c.code.ops_after for c in compiled),
+            assignments=sum(len(c.code.assignments) for c in compiled),
+        )
+    return {"numpy": (f"{module.prefix}_numpy.py", text)}

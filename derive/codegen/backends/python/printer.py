@@ -1,0 +1,28 @@
+"""The NumPy printer: SymPy's, lightly subclassed.
+
+Squares and small integer powers are expanded to products by SymPy's rewriting passes before
+printing (:func:`rpr3gen_derive.codegen.backends.prepare`), never by editing printed text.
+"""
+
+from __future__ import annotations
+
+import sympy as sp
+from rpr3gen_derive.codegen.backends import prepare
+from rpr3gen_derive.codegen.functions import INV_TWO_PI, TWO_PI
+from sympy.printing.numpy import NumPyPrinter
+
+
+class NumpyPrinter(NumPyPrinter):
+    """NumPy code over arrays of samples; names qualified as ``numpy.*``."""
+
+    def __init__(self) -> None:
+        super().__init__({"fully_qualified_modules": True, "inline": True})
+
+    def _print_wrap_angle(self, expr: sp.Expr) -> str:
+        x = self._print(expr.args[0])
+        return f"(({x}) - {TWO_PI}*numpy.rint(({x})*{INV_TWO_PI}))"
+
+
+def numpy_code(expr: sp.Expr) -> str:
+    """One NumPy expression."""
+    return NumpyPrinter().doprint(prepare(expr))

@@ -1,0 +1,214 @@
+"""The engine's driver: compile each function spec, hand it to every backend, write a manifest.
+
+Output is byte-identical for identical sources: no dates, versions, paths or hash-seed order.
+Every file carries the SHA-256 of the sources it was derived from (:func:`files.source_hash`).
+
+Stages can be timed: pass ``stage``, a callable that returns a context manager for a stage name
+(``"cse"``, ``"print"``, ``"render"``); each stage may be entered several times.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+from collections.abc import Callable, Iterable, Sequence
+from contextlib import AbstractContextManager
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import jinja2
+import sympy as sp
+from rpr3gen_derive.codegen.cse import StraightLine, straight_line
+from rpr3gen_derive.codegen.files import source_hash
+from rpr3gen_derive.codegen.spec import Argument, FunctionSpec, ModuleSpec
+
+Stage = Callable[[str], AbstractContextManager[object]]
+
+ENGINE_DIR = Path(__file__).resolve().parent
+
+
+def no_stage(name: str) -> AbstractContextManager[object]:
+    """The default stage hook: does nothing."""
+    return contextlib.nullcontext()
+
+
+def environment() -> jinja2.Environment:
+    """Strict Jinja2: an undefined name is an error, whitespace is the template's own."""
+    from rpr3gen_derive.codegen.backends.c import comment
+
+    env = jinja2.Environment(
+        loader=jinja2.FileSystemLoader(ENGINE_DIR),
+        undefined=jinja2.StrictUndefined,
+        trim_blocks=True,
+        lstrip_blocks=True,
+        keep_trailing_newline=True,
+        autoescape=False,
+    )
+    env.filters["c_comment"] = comment
+    return env
+
+
+def table_count(table: str) -> str:
+    """The count macro's suffix of a name table: ``output_names`` -> ``NUM_OUTPUTS``."""
+    return f"NUM_{table.removesuffix('_names').upper()}S"
+
+
+@dataclass(frozen=True)
+class Compiled:
+    """A function spec after common subexpression elimination, with what the backends need."""
+
+    spec: FunctionSpec
+    code: StraightLine
+    used_params: tuple[tuple[int, str], ...]  # (index in params, name)
+    used_inputs: tuple[tuple[str, int, str], ...]  # (input, index, symbol name)
+    slots: tuple[tuple[str, int], ...]  # flat output index -> (output, component index)
+
+    @property
+    def input_symbols(self) -> set[sp.Symbol]:
+        return {s for arg in self.spec.inputs for s in arg.symbols}
+
+
+def compile_function(spec: FunctionSpec, params: Argument) -> Compiled:
+    """Eliminate common subexpressions of ``spec`` and record which inputs it reads."""
+    flat = spec.flat_outputs()
+    code = straight_line(spec.program, [(f"{o}[{k}]", e) for o, k, e in flat])
+    used = set().union(*(rhs.free_symbols for _, rhs in code.assignments + code.outputs))
+    names = {str(s) for s in used}
+    unknown = names - {str(s) for s in params.symbols} - {str(s) for s, _ in code.assignments}
+    unknown -= {str(s) for arg in spec.inputs for s in arg.symbols}
+    if unknown:
+        raise ValueError(f"{spec.name}: symbols neither inputs nor parameters: {sorted(unknown)}")
+    return Compiled(
+        spec=spec,
+        code=code,
+        used_params=tuple((k, str(s)) for k, s in enumerate(params.symbols) if str(s) in names),
+        used_inputs=tuple(
+            (arg.name, k, str(s))
+            for arg in spec.inputs
+            for k, s in enumerate(arg.symbols)
+            if str(s) in names
+        ),
+        slots=tuple((o, k) for o, k, _ in flat),
+    )
+
+
+def _components(arg: Any) -> list[dict[str, str]]:
+    return [{"name": c.name, "unit": c.unit, "meaning": c.meaning} for c in arg.components]
+
+
+def manifest(module: ModuleSpec, digest: str, files: dict[str, str]) -> str:
+    """The module's manifest (JSON): what the runtime needs to call every function by name."""
+    prefix = module.prefix
+    data = {
+        "generated": "by rpr3gen from derive/ (`rpr3gen generate`): do not edit",
+        "source_hash": digest,
+        "format": 1,
+        "prefix": prefix,
+        "variant": module.variant,
+        "files": files,
+        "params": _components(module.params),
+        "return_codes": [
+            {"name": c.name, "value": c.value, "meaning": c.meaning} for c in module.return_codes
+        ],
+        "thresholds": [
+            {"name": t.name, "value": t.value, "meaning": t.meaning} for t in module.thresholds
+        ],
+        "functions": [
+            {
+                "name": f.name,
+                "c_symbol": f"{prefix}_{f.name}",
+                "c_batch_symbol": f"{prefix}_{f.name}_batch",
+                "numpy_function": f"{prefix}_{f.name}",
+                "doc": f.doc,
+                "inputs": [
+                    {"name": a.name, "doc": a.doc, "components": _components(a)} for a in f.inputs
+                ],
+                "outputs": [
+                    {
+                        "name": o.name,
+                        "doc": o.doc,
+                        "table": f"{prefix}_{o.table}" if o.table else None,
+                        "components": _components(o),
+                    }
+                    for o in f.outputs
+                ],
+                "checks": [
+                    {
+                        "kind": c.kind,
+                        "code": c.code,
+                        "output": c.output,
+                        "component": c.component,
+                        "threshold": c.threshold,
+                    }
+                    for c in f.checks
+                ],
+            }
+            for f in module.functions
+        ],
+    }
+    return json.dumps(data, indent=2) + "\n"
+
+
+class Generator:
+    """Renders modules through every backend.
+
+    Args:
+        hash_roots: folders whose ``*.py`` and ``*.jinja`` files the output is derived from (the
+            engine's own folder is always included).
+        package_doc: docstring of the generated package's ``__init__.py``.
+        stage: timing hook, see the module docstring.
+    """
+
+    def __init__(
+        self, hash_roots: Sequence[Path], package_doc: str, stage: Stage = no_stage
+    ) -> None:
+        self.hash_roots = (ENGINE_DIR, *hash_roots)
+        self.package_doc = package_doc
+        self.stage = stage
+        self.env = environment()
+
+    def source_hash(self) -> str:
+        return source_hash(self.hash_roots)
+
+    def render_module(self, module: ModuleSpec, digest: str) -> dict[str, str]:
+        """Every file of one module, ``{relative path: text}``, under ``{variant}/``."""
+        from rpr3gen_derive.codegen.backends import c, python
+
+        with self.stage("cse"):
+            compiled = [compile_function(f, module.params) for f in module.functions]
+        files: dict[str, str] = {}
+        roles: dict[str, str] = {}
+        for backend in (python, c):
+            for role, (name, text) in backend.render(
+                module, compiled, digest, self.env, self.stage
+            ).items():
+                files[name] = text
+                roles[role] = name
+        with self.stage("render"):
+            files["__init__.py"] = self.env.get_template("templates/variant_init.py.jinja").render(
+                module=module, source_hash=digest
+            )
+            files["manifest.json"] = manifest(module, digest, roles)
+        return {f"{module.variant}/{name}": text for name, text in sorted(files.items())}
+
+    def render(
+        self, modules: Iterable[ModuleSpec], variants: Sequence[str] | None = None
+    ) -> dict[str, str]:
+        """Every generated file, ``{relative path: text}``, and the package's ``__init__.py``.
+
+        ``variants`` lists every variant of the package (default: those of ``modules``), so that
+        rendering some of them writes the same package ``__init__.py`` as rendering all.
+        """
+        digest = self.source_hash()
+        files: dict[str, str] = {}
+        rendered = []
+        for module in modules:
+            files.update(self.render_module(module, digest))
+            rendered.append(module.variant)
+        variants = list(variants) if variants is not None else rendered
+        with self.stage("render"):
+            files["__init__.py"] = self.env.get_template("templates/package_init.py.jinja").render(
+                doc=self.package_doc, source_hash=digest, variants=variants
+            )
+        return dict(sorted(files.items()))

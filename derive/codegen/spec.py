@@ -1,0 +1,174 @@
+"""Specs: the one source of each generated function, and of the module that holds them.
+
+A :class:`FunctionSpec` names a function, its ordered per-sample inputs and outputs (each an
+array of named, documented components), the program of assignments that computes the outputs,
+its docstring and its failure conditions. Every generated artefact is drawn from it: the NumPy
+function, the C declaration, definition and batch variant, the C name tables, the manifest the
+runtime reads (and builds its C binding from), and the documentation of array layouts.
+
+A :class:`ModuleSpec` gathers the functions of one generated module (one variant of a robot)
+with what they share: the parameter vector, the return codes and the thresholds.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Literal
+
+import sympy as sp
+from rpr3gen_derive.codegen.program import Program
+
+
+@dataclass(frozen=True)
+class Component:
+    """One scalar of an argument: its name (an identifier), unit and meaning."""
+
+    name: str
+    unit: str = ""
+    meaning: str = ""
+
+
+@dataclass(frozen=True)
+class Argument:
+    """An input or the parameter vector: ordered symbols, one :class:`Component` each.
+
+    ``table`` names the C name table (``{prefix}_{table}``) and its count macro
+    (``{PREFIX}_NUM_{TABLE}``, the table's last word) when the argument has one.
+    """
+
+    name: str
+    symbols: tuple[sp.Symbol, ...]
+    components: tuple[Component, ...]
+    doc: str
+    table: str | None = None
+
+    def __post_init__(self) -> None:
+        if len(self.symbols) != len(self.components):
+            raise ValueError(f"argument {self.name}: symbols and components differ in number")
+
+    @property
+    def size(self) -> int:
+        return len(self.symbols)
+
+
+@dataclass(frozen=True)
+class Output:
+    """An output array: one expression per component, in program symbols."""
+
+    name: str
+    exprs: tuple[sp.Expr, ...]
+    components: tuple[Component, ...]
+    doc: str
+    table: str | None = None
+
+    def __post_init__(self) -> None:
+        if len(self.exprs) != len(self.components):
+            raise ValueError(f"output {self.name}: expressions and components differ in number")
+
+    @property
+    def size(self) -> int:
+        return len(self.exprs)
+
+
+@dataclass(frozen=True)
+class ReturnCode:
+    """A return code of every function of a module (``{PREFIX}_{name}``)."""
+
+    name: str
+    value: int
+    meaning: str
+
+
+@dataclass(frozen=True)
+class Threshold:
+    """A named constant of the failure conditions (``{PREFIX}_{name}``).
+
+    ``literal`` is how it is written in C and Python (``"1e-9"``).
+    """
+
+    name: str
+    literal: str
+    meaning: str
+
+    @property
+    def value(self) -> float:
+        return float(self.literal)
+
+
+CheckKind = Literal["inputs_not_finite", "below", "outputs_not_finite"]
+
+
+@dataclass(frozen=True)
+class Check:
+    """A failure condition; the first that holds gives the function's return code.
+
+    ``inputs_not_finite``: an input component is NaN or infinite.
+    ``below``: the output component ``output[component]`` is below the threshold (or NaN).
+    ``outputs_not_finite``: an output component is NaN or infinite.
+    """
+
+    kind: CheckKind
+    code: str
+    output: str | None = None
+    component: str | None = None
+    threshold: str | None = None
+
+
+@dataclass(frozen=True)
+class FunctionSpec:
+    """A generated function ``outputs = f(params, inputs)``, computed by ``program``."""
+
+    name: str
+    doc: str
+    inputs: tuple[Argument, ...]
+    outputs: tuple[Output, ...]
+    program: Program
+    checks: tuple[Check, ...] = ()
+
+    def output(self, name: str) -> Output:
+        return next(o for o in self.outputs if o.name == name)
+
+    def flat_outputs(self) -> list[tuple[str, int, sp.Expr]]:
+        """``(output name, component index, expression)`` for every output component, in order."""
+        return [(o.name, k, e) for o in self.outputs for k, e in enumerate(o.exprs)]
+
+
+@dataclass(frozen=True)
+class ModuleSpec:
+    """The functions of one generated module and what they share.
+
+    ``prefix`` starts every C name (``rpr3_inverse_dynamics``, ``RPR3_OK``) and the generated
+    files' names (``rpr3.h``, ``rpr3.c``, ``rpr3_numpy.py``). ``defines`` are extra C macros,
+    ``(name, C literal, comment)``.
+    """
+
+    prefix: str
+    variant: str
+    doc: str
+    params: Argument
+    functions: tuple[FunctionSpec, ...]
+    return_codes: tuple[ReturnCode, ...]
+    thresholds: tuple[Threshold, ...] = ()
+    defines: tuple[tuple[str, str, str], ...] = field(default_factory=tuple)
+
+    def __post_init__(self) -> None:
+        codes = {c.name for c in self.return_codes}
+        thresholds = {t.name for t in self.thresholds}
+        if "OK" not in codes or next(c for c in self.return_codes if c.name == "OK").value != 0:
+            raise ValueError("a module needs the return code OK = 0")
+        names = [f.name for f in self.functions]
+        if len(set(names)) != len(names):
+            raise ValueError(f"functions defined twice in {names}")
+        for function in self.functions:
+            for check in function.checks:
+                if check.code not in codes:
+                    raise ValueError(f"{function.name}: unknown return code {check.code!r}")
+                if check.kind == "below":
+                    if check.threshold not in thresholds:
+                        raise ValueError(f"{function.name}: unknown threshold {check.threshold!r}")
+                    out = function.output(str(check.output))
+                    if check.component not in [c.name for c in out.components]:
+                        raise ValueError(f"{function.name}: no output {check.component!r}")
+
+    def code(self, name: str) -> ReturnCode:
+        return next(c for c in self.return_codes if c.name == name)

@@ -1,0 +1,190 @@
+"""The generated code's manifest: every function's signature, name tables, thresholds and codes.
+
+``rpr3gen generate`` writes one ``manifest.json`` per variant beside the generated NumPy and C
+sources. The runtime reads nothing else about the generated functions: it calls them by name,
+builds the C binding and applies the failure policy (:mod:`rpr3gen.policy`) from it.
+
+A generated folder is either the installed package ``rpr3gen_generated`` (the default) or any
+folder written by ``rpr3gen generate --out DIR`` (``load_model(..., generated=DIR)``).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from dataclasses import dataclass
+from functools import cache
+from importlib import resources
+from pathlib import Path
+
+from rpr3gen.errors import Rpr3genError
+
+#: The manifest format this runtime reads.
+FORMAT = 1
+
+
+@dataclass(frozen=True)
+class ArgInfo:
+    """An input or output array of a generated function: its component names and units."""
+
+    name: str
+    names: tuple[str, ...]
+    units: tuple[str, ...]
+    doc: str
+    table: str | None = None
+
+    @property
+    def size(self) -> int:
+        return len(self.names)
+
+
+@dataclass(frozen=True)
+class CheckInfo:
+    """A failure condition (see ``derive/codegen/spec.py``), resolved to numbers."""
+
+    kind: str  # "inputs_not_finite", "below" or "outputs_not_finite"
+    code: int
+    output: int | None = None  # index of the output array ("below")
+    component: int | None = None  # index of the component in it ("below")
+    threshold: float | None = None  # ("below")
+
+
+@dataclass(frozen=True)
+class FunctionInfo:
+    """One generated function, as the manifest describes it."""
+
+    name: str
+    c_symbol: str
+    c_batch_symbol: str
+    numpy_function: str
+    doc: str
+    inputs: tuple[ArgInfo, ...]
+    outputs: tuple[ArgInfo, ...]
+    checks: tuple[CheckInfo, ...]
+
+
+@dataclass(frozen=True)
+class Variant:
+    """One generated variant (a folder with ``manifest.json``, NumPy and C sources)."""
+
+    folder: Path
+    prefix: str
+    variant: str
+    source_hash: str
+    files: dict[str, str]
+    param_names: tuple[str, ...]
+    return_codes: dict[str, int]
+    code_meanings: dict[int, str]
+    thresholds: dict[str, float]
+    functions: dict[str, FunctionInfo]
+
+    def function(self, name: str) -> FunctionInfo:
+        """The function called ``name`` (without the prefix), or a clear error."""
+        try:
+            return self.functions[name]
+        except KeyError:
+            known = ", ".join(self.functions)
+            raise Rpr3genError(
+                f"{self.folder}: no generated function {name!r} (it has: {known}); "
+                "run `rpr3gen generate`"
+            ) from None
+
+    def path(self, role: str) -> Path:
+        """Path of a generated file by role: ``numpy``, ``c_header`` or ``c_source``."""
+        return self.folder / self.files[role]
+
+
+def default_folder() -> Path:
+    """Folder of the installed generated package ``rpr3gen_generated``."""
+    return Path(str(resources.files("rpr3gen_generated")))
+
+
+def _folder(generated: str | os.PathLike[str] | None) -> Path:
+    return default_folder() if generated is None else Path(generated).resolve()
+
+
+def _arg(data: dict) -> ArgInfo:
+    comps = data["components"]
+    return ArgInfo(
+        name=data["name"],
+        names=tuple(c["name"] for c in comps),
+        units=tuple(c["unit"] for c in comps),
+        doc=data["doc"],
+        table=data.get("table"),
+    )
+
+
+def _function(data: dict, codes: dict[str, int], thresholds: dict[str, float]) -> FunctionInfo:
+    outputs = tuple(_arg(o) for o in data["outputs"])
+    checks = []
+    for c in data["checks"]:
+        if c["kind"] == "below":
+            index = next(k for k, o in enumerate(outputs) if o.name == c["output"])
+            checks.append(
+                CheckInfo(
+                    kind="below",
+                    code=codes[c["code"]],
+                    output=index,
+                    component=outputs[index].names.index(c["component"]),
+                    threshold=thresholds[c["threshold"]],
+                )
+            )
+        else:
+            checks.append(CheckInfo(kind=c["kind"], code=codes[c["code"]]))
+    return FunctionInfo(
+        name=data["name"],
+        c_symbol=data["c_symbol"],
+        c_batch_symbol=data["c_batch_symbol"],
+        numpy_function=data["numpy_function"],
+        doc=data["doc"],
+        inputs=tuple(_arg(a) for a in data["inputs"]),
+        outputs=outputs,
+        checks=tuple(checks),
+    )
+
+
+@cache
+def _load(folder: Path, variant: str) -> Variant:
+    path = folder / variant / "manifest.json"
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        found = ", ".join(available(folder)) or "none"
+        raise Rpr3genError(
+            f"{path}: no generated variant {variant!r} here (variants found: {found}); "
+            "run `rpr3gen generate`"
+        ) from None
+    except (OSError, ValueError) as exc:
+        raise Rpr3genError(f"{path}: unreadable manifest: {exc}") from None
+    if data.get("format") != FORMAT:
+        raise Rpr3genError(
+            f"{path}: manifest format {data.get('format')!r}, this runtime reads {FORMAT}; "
+            "regenerate with this version (`rpr3gen generate`)"
+        )
+    codes = {c["name"]: int(c["value"]) for c in data["return_codes"]}
+    thresholds = {t["name"]: float(t["value"]) for t in data["thresholds"]}
+    return Variant(
+        folder=folder / variant,
+        prefix=data["prefix"],
+        variant=data["variant"],
+        source_hash=data["source_hash"],
+        files=dict(data["files"]),
+        param_names=tuple(p["name"] for p in data["params"]),
+        return_codes=codes,
+        code_meanings={int(c["value"]): c["meaning"] for c in data["return_codes"]},
+        thresholds=thresholds,
+        functions={f["name"]: _function(f, codes, thresholds) for f in data["functions"]},
+    )
+
+
+def load(variant: str, generated: str | os.PathLike[str] | None = None) -> Variant:
+    """The manifest of ``variant`` in the generated folder ``generated`` (default: installed)."""
+    return _load(_folder(generated), variant)
+
+
+def available(generated: str | os.PathLike[str] | Path | None = None) -> tuple[str, ...]:
+    """Variants present in a generated folder (sub-folders with a manifest), sorted."""
+    folder = _folder(generated)
+    if not folder.is_dir():
+        return ()
+    return tuple(sorted(p.parent.name for p in folder.glob("*/manifest.json")))

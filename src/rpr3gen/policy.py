@@ -1,0 +1,132 @@
+"""The failure policy, in one place: which samples fail, with which return code, and which a
+command refuses.
+
+Two levels:
+
+1. **What the generated functions refuse** (a return code other than 0): the failure conditions
+   of each function, with their thresholds and codes, come from the manifest
+   (:mod:`rpr3gen.manifest`; e.g. ``conditioning`` under ``MIN_CONDITIONING`` = 1e-9 is
+   ``SINGULAR``). The generated C applies them itself; :func:`return_codes` applies the same
+   conditions to any backend's results, so the NumPy and C paths agree on every code, and
+   :func:`apply` blanks the failed samples (NaN).
+2. **What ``rpr3gen simulate`` refuses** on top: poses closer to a singularity than
+   ``--min-conditioning`` (:data:`DEFAULT_MIN_CONDITIONING`) and piston displacements outside a
+   model's stroke limits (:func:`invalid_samples`).
+
+The measure of closeness to a parallel singularity is the generated output ``conditioning``
+(``derive/rpr3/virtual_work.py``: the Hadamard ratio of the closure matrix whose solve gives every
+load, with the platform's rotation scaled by its radius): 1 at best, 0 at a singular pose, where
+the loads grow as 1/conditioning.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from rpr3gen.manifest import FunctionInfo
+from rpr3gen.model import LEGS, Model
+
+#: Default refusal threshold of ``rpr3gen simulate`` on ``conditioning``: loads there are
+#: ~1000x their well-conditioned size. On the paper's robot and motions it stays above 0.6.
+DEFAULT_MIN_CONDITIONING = 1e-3
+
+
+def return_codes(
+    function: FunctionInfo, inputs: Sequence[np.ndarray], outputs: Sequence[np.ndarray]
+) -> np.ndarray:
+    """Per sample, the code the generated C returns for it: 0, or the first failed check's.
+
+    Args:
+        function: the function, from the manifest.
+        inputs: its inputs, each (n, size).
+        outputs: its outputs as computed, each (n, size) (any backend; NaN rows allowed).
+
+    Returns:
+        (n,) int array.
+    """
+    n = inputs[0].shape[0]
+    codes = np.zeros(n, dtype=np.intc)
+    pending = np.ones(n, dtype=bool)
+    with np.errstate(invalid="ignore"):
+        for check in function.checks:
+            if check.kind == "inputs_not_finite":
+                failed = ~np.all([np.isfinite(a).all(axis=1) for a in inputs], axis=0)
+            elif check.kind == "below":
+                assert check.output is not None
+                assert check.component is not None
+                value = outputs[check.output][:, check.component]
+                failed = ~(value >= check.threshold)
+            else:
+                failed = ~np.all([np.isfinite(a).all(axis=1) for a in outputs], axis=0)
+            hit = failed & pending
+            codes[hit] = check.code
+            pending &= ~hit
+    return codes
+
+
+def apply(
+    function: FunctionInfo, inputs: Sequence[np.ndarray], outputs: Sequence[np.ndarray]
+) -> np.ndarray:
+    """Blank (NaN) every output row of a failed sample, in place; return the codes."""
+    codes = return_codes(function, inputs, outputs)
+    failed = codes != 0
+    if failed.any():
+        for out in outputs:
+            out[failed] = np.nan
+    return codes
+
+
+@dataclass(frozen=True)
+class Invalid:
+    """The samples at fault and why the first one is."""
+
+    mask: np.ndarray  # (n,) bool
+    first: int  # index of the first sample at fault
+    reason: str  # one line, without the time
+
+
+def invalid_samples(
+    model: Model,
+    out: Mapping[str, np.ndarray],
+    min_conditioning: float,
+    singular_below: float,
+) -> Invalid | None:
+    """Samples that are singular, too close to a singularity, or outside a stroke limit.
+
+    Args:
+        model: the robot (its stroke limits).
+        out: the inverse dynamics' outputs.
+        min_conditioning: refuse ``conditioning`` below this.
+        singular_below: the generated code's own floor (``MIN_CONDITIONING`` of the manifest),
+            under which a pose is reported as singular rather than as too close.
+    """
+    conditioning = out["conditioning"]
+    with np.errstate(invalid="ignore"):
+        singular = ~(conditioning >= min_conditioning)
+        outside = {
+            leg: (out[f"lambda21_{leg}"] < lo) | (out[f"lambda21_{leg}"] > hi)
+            for leg, (lo, hi) in zip(LEGS, model.stroke or (), strict=False)
+        }
+    mask = singular.copy()
+    for leg_mask in outside.values():
+        mask |= leg_mask
+    if not mask.any():
+        return None
+    first = int(np.argmax(mask))
+    if singular[first]:
+        c = conditioning[first]
+        what = "a singular pose" if not c >= singular_below else f"conditioning {c:.3g}"
+        reason = f"{what}, under the threshold {min_conditioning:g} (too close to a singularity)"
+    else:
+        assert model.stroke is not None
+        leg = next(leg for leg, leg_mask in outside.items() if leg_mask[first])
+        lo, hi = model.stroke[LEGS.index(leg)]
+        value = out[f"lambda21_{leg}"][first]
+        reason = (
+            f"piston displacement lambda21_{leg} = {value:.6g} m "
+            f"outside its stroke [{lo:g}, {hi:g}]"
+        )
+    return Invalid(mask=mask, first=first, reason=reason)
