@@ -3,8 +3,9 @@
 Output is byte-identical for identical sources: no dates, versions, paths or hash-seed order.
 Every file carries the SHA-256 of the sources it was derived from (:func:`files.source_hash`).
 
-Stages can be timed: pass ``stage``, a callable that returns a context manager for a stage name
-(``"cse"``, ``"print"``, ``"render"``); each stage may be entered several times.
+Stages can be timed: pass ``stage``, a callable that returns a context manager for a stage name:
+``"variant:NAME"`` around all the work on one module, inside it ``"cse"``, ``"print"`` and
+``"render"`` (a robot's own driver adds ``"derive"``); a stage may be entered several times.
 """
 
 from __future__ import annotations
@@ -173,6 +174,10 @@ class Generator:
 
     def render_module(self, module: ModuleSpec, digest: str) -> dict[str, str]:
         """Every file of one module, ``{relative path: text}``, under ``{variant}/``."""
+        with self.stage(f"variant:{module.variant}"):
+            return self._render_module(module, digest)
+
+    def _render_module(self, module: ModuleSpec, digest: str) -> dict[str, str]:
         from rpr3gen_derive.codegen.backends import c, python
 
         with self.stage("cse"):

@@ -34,8 +34,10 @@ def render(
 ) -> dict[str, str]:
     """Every generated file for the given actuation schemes, ``{relative path: text}``."""
     gen = generator(stage)
-    with stage("derive"):
-        modules = [module(actuation, functions) for actuation in actuations]
+    modules = []
+    for actuation in actuations:
+        with stage(f"variant:{actuation}"), stage("derive"):
+            modules.append(module(actuation, functions))
     return gen.render(modules, variants=ACTUATIONS)
 
 

@@ -239,6 +239,11 @@ def _spec(builder: FunctionBuilder, actuation: str) -> FunctionSpec:
     return builder(actuation)
 
 
+def clear_cache() -> None:
+    """Forget the specs derived so far (they are derived once per process otherwise)."""
+    _spec.cache_clear()
+
+
 def module(actuation: str, functions: Mapping[str, FunctionBuilder] | None = None) -> ModuleSpec:
     """The generated module of one actuation scheme: every function of ``functions``."""
     if actuation not in ACTUATIONS:
