@@ -1,0 +1,193 @@
+"""The generator engine: a new function is one registry entry, and every backend agrees on codes.
+
+A toy function (the three leg lengths of a pose) is added to a temporary registry, rendered
+into a temporary folder, compiled and imported there, and called through the runtime's
+evaluators by name: nothing outside the registry entry below is written for it.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+import numpy as np
+import pytest
+import sympy as sp
+from rpr3gen_derive.codegen import Check, Component, FunctionSpec, Output, Program
+from rpr3gen_derive.codegen.files import write_files
+from rpr3gen_derive.rpr3 import generate, registry
+from rpr3gen_derive.rpr3 import symbols as syms
+
+import rpr3gen
+from rpr3gen import manifest
+from rpr3gen.evaluators import evaluator
+
+ACTUATIONS = ("revolute", "prismatic")
+
+
+def leg_lengths(actuation: str) -> FunctionSpec:
+    """Toy spec: |A1 A3| of each leg at the pose q (eq. 5), and its smallest value."""
+    prog = Program()
+    cos_phi = prog.define("cos_phi", sp.cos(syms.phi), "pose")
+    sin_phi = prog.define("sin_phi", sp.sin(syms.phi), "pose")
+    lengths = []
+    for leg in syms.LEGS:
+        p, a1 = syms.platform_joint(leg), syms.base_pivot(leg)
+        dx = syms.x + cos_phi * p[0] - sin_phi * p[1] - a1[0]
+        dy = syms.y + sin_phi * p[0] + cos_phi * p[1] - a1[1]
+        lengths.append(prog.define(f"L_{leg}", sp.sqrt(dx**2 + dy**2), "pose"))
+    return FunctionSpec(
+        name="leg_lengths",
+        doc="Leg lengths |A1 A3| at the platform pose q (toy function of the engine's test).",
+        inputs=(registry.POSE,),
+        outputs=(
+            Output(
+                "lengths",
+                tuple(lengths),
+                tuple(Component(f"L_{leg}", "m", f"|{leg}1 {leg}3|") for leg in syms.LEGS),
+                "leg lengths",
+            ),
+        ),
+        program=prog,
+        checks=(Check("inputs_not_finite", "NOT_FINITE"),),
+    )
+
+
+@pytest.fixture(scope="module")
+def toy_folder(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    functions = {**registry.FUNCTIONS, "leg_lengths": leg_lengths}
+    out = tmp_path_factory.mktemp("generated")
+    write_files(out, generate.render(ACTUATIONS, functions=functions))
+    return out
+
+
+def _model(actuation: str, folder: Path | None = None) -> rpr3gen.Model:
+    paper = rpr3gen.load_model()
+    return dataclasses.replace(
+        paper, actuation=actuation, generated=None if folder is None else str(folder)
+    )
+
+
+def _reference_lengths(model: rpr3gen.Model, q: np.ndarray) -> np.ndarray:
+    p = model.params
+    c, s = np.cos(q[:, 2]), np.sin(q[:, 2])
+    columns = []
+    for leg in "ABC":
+        x3 = q[:, 0] + c * p[f"x{leg}3"] - s * p[f"y{leg}3"]
+        y3 = q[:, 1] + s * p[f"x{leg}3"] + c * p[f"y{leg}3"]
+        columns.append(np.hypot(x3 - p[f"x{leg}1"], y3 - p[f"y{leg}1"]))
+    return np.stack(columns, axis=1)
+
+
+@pytest.mark.parametrize("actuation", ACTUATIONS)
+def test_a_toy_spec_is_rendered_compiled_and_called_by_name(
+    toy_folder: Path, actuation: str
+) -> None:
+    assert "leg_lengths" not in registry.FUNCTIONS  # the temporary registry only
+    variant = manifest.load(actuation, toy_folder)
+    assert set(variant.functions) == {"inverse_dynamics", "leg_lengths"}
+    header = variant.path("c_header").read_text()
+    assert "int rpr3_leg_lengths(const double *params, const double q[3], double lengths[3]);" in (
+        header
+    )
+    model = _model(actuation, toy_folder)
+    rng = np.random.default_rng(7)
+    q = rng.uniform([-0.05, -0.05, -0.3], [0.05, 0.05, 0.3], size=(40, 3))
+    q[3, 1] = np.nan
+    results = {}
+    for backend in ("numpy", "c"):
+        (lengths,), codes = rpr3gen.evaluate(model, "leg_lengths", (q,), backend=backend)
+        results[backend] = lengths
+        assert codes[3] == variant.return_codes["NOT_FINITE"]
+        assert np.count_nonzero(codes) == 1
+        assert np.isnan(lengths[3]).all()
+    np.testing.assert_allclose(results["c"], results["numpy"], rtol=1e-14, atol=0)
+    ok = np.isfinite(q).all(axis=1)
+    np.testing.assert_allclose(
+        results["numpy"][ok], _reference_lengths(model, q[ok]), rtol=1e-13, atol=0
+    )
+    # The inverse dynamics of the same folder are the installed ones.
+    packaged = rpr3gen.inverse_dynamics(
+        _model(actuation), q[ok], np.zeros((ok.sum(), 3)), np.zeros((ok.sum(), 3))
+    )
+    here = rpr3gen.inverse_dynamics(model, q[ok], np.zeros((ok.sum(), 3)), np.zeros((ok.sum(), 3)))
+    for name in rpr3gen.OUTPUT_NAMES:
+        assert here[name].tobytes() == packaged[name].tobytes()
+
+
+@pytest.mark.parametrize("actuation", ACTUATIONS)
+def test_toy_single_call_matches_batch(toy_folder: Path, actuation: str) -> None:
+    model = _model(actuation, toy_folder)
+    q = np.array([[0.01, -0.02, 0.1], [0.0, 0.0, 0.0]])
+    (batch,), _ = rpr3gen.evaluate(model, "leg_lengths", (q,), backend="c")
+    for backend in ("c", "numpy"):
+        ev = rpr3gen.SampleEvaluator(model, backend=backend, function="leg_lengths")
+        for i in range(len(q)):
+            ev.q[:] = q[i]
+            assert ev() == 0
+            np.testing.assert_allclose(ev.lengths, batch[i], rtol=1e-15, atol=0)
+        ev.q[:] = (0.0, np.inf, 0.0)
+        before = ev.lengths.copy()
+        assert ev() == 1
+        assert np.array_equal(ev.lengths, before)
+
+
+def _raw_conditioning(model: rpr3gen.Model, q: np.ndarray) -> np.ndarray:
+    """The generated NumPy's conditioning output, before any failure policy is applied."""
+    variant = manifest.load(model.actuation)
+    info = variant.function("inverse_dynamics")
+    ev = evaluator(variant, "numpy")
+    zero = np.zeros_like(q)
+    (out,) = ev.allocate(info, len(q))
+    ev.run(info, model.vector(variant.param_names), [q, zero, zero], [out])
+    return out[:, info.outputs[0].names.index("conditioning")]
+
+
+def _nearly_singular_pose(model: rpr3gen.Model, floor: float) -> np.ndarray:
+    """A pose with 0 < conditioning < floor: golden-section search along x across a parallel
+    singularity of the paper robot (near x = -0.158, y = 0.432, phi = 0.7)."""
+    ratio = (np.sqrt(5.0) - 1.0) / 2.0
+    lo, hi = -0.17, -0.15
+
+    def cond(x: float) -> float:
+        return float(_raw_conditioning(model, np.array([[x, 0.432, 0.7]]))[0])
+
+    for _ in range(200):
+        a, b = hi - ratio * (hi - lo), lo + ratio * (hi - lo)
+        if cond(a) < cond(b):
+            hi = b
+        else:
+            lo = a
+        x = (lo + hi) / 2
+        if 0.0 < cond(x) < floor:
+            return np.array([x, 0.432, 0.7])
+    raise AssertionError("no pose with 0 < conditioning < floor found")
+
+
+@pytest.mark.parametrize("actuation", ACTUATIONS)
+def test_numpy_and_c_agree_on_every_return_code(actuation: str) -> None:
+    model = _model(actuation)
+    variant = manifest.load(actuation)
+    floor = variant.thresholds["MIN_CONDITIONING"]
+    p = model.params
+    nearly = _nearly_singular_pose(model, floor)
+    assert 0.0 < _raw_conditioning(model, nearly[np.newaxis])[0] < floor
+    q = np.array(
+        [
+            [0.01, -0.02, 0.1],  # ok
+            [0.0, np.nan, 0.0],  # an input not finite
+            [p["xB1"] - p["xB3"], p["yB1"] - p["yB3"], 0.0],  # leg B of zero length
+            nearly,  # 0 < conditioning < MIN_CONDITIONING
+        ]
+    )
+    expected = [0, variant.return_codes["NOT_FINITE"], *[variant.return_codes["SINGULAR"]] * 2]
+    zero = np.zeros_like(q)
+    for backend in ("numpy", "c"):
+        _, codes = rpr3gen.evaluate(model, "inverse_dynamics", (q, zero, zero), backend=backend)
+        assert codes.tolist() == expected, backend
+        ev = rpr3gen.SampleEvaluator(model, backend=backend)
+        single = []
+        for i in range(len(q)):
+            ev.q[:], ev.qd[:], ev.qdd[:] = q[i], zero[i], zero[i]
+            single.append(ev())
+        assert single == expected, backend
