@@ -1,6 +1,6 @@
 """Independent Newton-Euler reference for the inverse dynamics of the 3-RPR planar robot.
 
-Written only from ``shared/spec/conventions.md`` (the physics contract), with NumPy alone: it
+Written only from ``docs/conventions.md`` (the physics contract), with NumPy alone: it
 imports nothing from ``rpr3gen``, ``derive/`` or ``generated/``, so the tests that compare the
 production code against it check the symbolic virtual-work derivation against plain mechanics.
 

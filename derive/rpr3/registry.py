@@ -36,7 +36,7 @@ ACTUATIONS: tuple[str, ...] = ("revolute", "prismatic")
 
 @dataclass(frozen=True)
 class OutputFamily:
-    """One output of conventions.md, for each of the three legs."""
+    """One output of docs/conventions.md, for each of the three legs."""
 
     name: str
     unit: str
@@ -78,7 +78,7 @@ OUTPUT_NAMES: tuple[str, ...] = tuple(
 
 
 def _param_doc(name: str) -> tuple[str, str]:
-    """Unit and meaning of a model parameter (interfaces.md)."""
+    """Unit and meaning of a model parameter (docs/interfaces.md)."""
     fixed = {
         "l0": ("m", "|A1A2| = l0 + lambda21"),
         "l2": ("m", "|A2A3|"),

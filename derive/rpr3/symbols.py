@@ -16,7 +16,7 @@ POSE_NAMES: tuple[str, ...] = ("x", "y", "phi")
 VELOCITY_NAMES: tuple[str, ...] = ("dx", "dy", "dphi")
 ACCELERATION_NAMES: tuple[str, ...] = ("ddx", "ddy", "ddphi")
 
-#: Model parameters, in the order of the generated parameter vector (interfaces.md).
+#: Model parameters, in the order of the generated parameter vector (docs/interfaces.md).
 PARAM_NAMES: tuple[str, ...] = (
     "xA1", "yA1", "xB1", "yB1", "xC1", "yC1",
     "xA3", "yA3", "xB3", "yB3", "xC3", "yC3",

@@ -23,7 +23,7 @@ from rpr3gen.model import Model
 __all__ = ["BACKENDS", "OUTPUT_NAMES", "evaluate", "inverse_dynamics"]
 
 #: Output names of the inverse dynamics, family-major (``phi10_A, phi10_B, phi10_C,
-#: lambda21_A, ...``) as conventions.md, then ``conditioning``: closeness to a parallel
+#: lambda21_A, ...``) as docs/conventions.md, then ``conditioning``: closeness to a parallel
 #: singularity, 0 (singular) to 1.
 OUTPUT_NAMES: tuple[str, ...] = (
     manifest.load(manifest.available()[0]).function("inverse_dynamics").outputs[0].names

@@ -1,7 +1,7 @@
 """Robot model files: read, validate and turn into the numeric parameter vector.
 
-A model file (TOML, see ``interfaces.md``) describes one 3-RPR robot. :func:`load_model` reads
-it, checks every key and value, applies the defaults of ``conventions.md`` and returns a
+A model file (TOML, see ``docs/interfaces.md``) describes one 3-RPR robot. :func:`load_model` reads
+it, checks every key and value, applies the defaults of ``docs/conventions.md`` and returns a
 :class:`Model` whose ``params`` hold exactly :data:`PARAM_NAMES` in SI units (angles in rad),
 the inputs of the generated inverse-dynamics functions.
 
@@ -157,7 +157,7 @@ def load_model(
             model; ``None`` uses the installed generated package.
 
     Returns:
-        The validated model, with the defaults of ``conventions.md`` filled in.
+        The validated model, with the defaults of ``docs/conventions.md`` filled in.
 
     Raises:
         ModelError: If the file cannot be read, is not valid TOML, or any key or value is wrong;
@@ -437,7 +437,7 @@ class _Reader:
     def mass(
         self, m: Mapping[str, Any], params: dict[str, float], *, l1: float, r: float | None
     ) -> None:
-        """Fill c1, c2, m1..m3 and J1..J3 into ``params``, with the defaults of conventions.md."""
+        """Fill c1, c2, m1..m3 and J1..J3 into ``params`` (defaults: docs/conventions.md)."""
         l2 = params["l2"]
         m1 = self.number(m, "mass.m1", "m1", positive=True)
         m2 = self.number(m, "mass.m2", "m2", positive=True)

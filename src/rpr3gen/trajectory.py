@@ -2,7 +2,7 @@
 
 A trajectory samples the platform pose ``q = (x, y, phi)`` (position of G in the world frame, m,
 and the platform's rotation from the central configuration, rad) with its first and second time
-derivatives. The CSV layout is fixed by ``interfaces.md``: a header naming the columns
+derivatives. The CSV layout is fixed by ``docs/interfaces.md``: a header naming the columns
 ``t,x,y,phi,dx,dy,dphi,ddx,ddy,ddphi`` (any order, extra columns ignored), then one row per
 sample with time strictly increasing.
 """
