@@ -131,7 +131,10 @@ BACKENDS = ("numpy", "c")
 
 def run(model, q, qd, qdd, backend: str = "numpy") -> dict[str, np.ndarray]:
     out = rpr3gen.inverse_dynamics(model, q, qd, qdd, backend=backend)
-    expected = {f"{fam}_{leg}" for fam in ne.FAMILIES for leg in ne.LEGS} | {"conditioning"}
+    expected = {f"{fam}_{leg}" for fam in ne.FAMILIES for leg in ne.LEGS} | {
+        "conditioning",
+        "reach",
+    }
     assert set(out) == expected, (
         f"missing {sorted(expected - set(out))}, unexpected {sorted(set(out) - expected)}"
     )

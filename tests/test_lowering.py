@@ -24,6 +24,7 @@ CASES = {
     "wrapped angle": wrap_angle(5 * a - k),
     "parameters only, inside": (k + m**2) * a + sp.cos(k),
     "lone negation": -a,
+    "minimum of three": sp.Min(a, b * k, a - b),
 }
 
 

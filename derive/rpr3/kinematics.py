@@ -180,3 +180,16 @@ def leg_kinematics(prog: Program, leg: str, cos_phi: sp.Expr, sin_phi: sp.Expr) 
         gamma21=gamma21,
         eps32=eps32,
     )
+
+
+def reach(prog: Program, kinematics: dict[str, LegKinematics]) -> sp.Expr:
+    """The serial-singularity measure: ``min_i (l0 + lambda21_i) / l0 = min_i |A1A2_i| / l0``.
+
+    1 in the central configuration; it reaches 0 when a piston joint A2 comes onto its base pivot
+    A1, and is negative with the piston behind it. Poses where it is not positive are refused:
+    a real cylinder cannot put its piston behind the pivot, and refusing them keeps every leg at
+    least ``l2`` long, away from the serial singularity ``|A1A3| = 0`` where the leg's direction
+    (eq. 5) is undefined and every load grows as 1 / |A1A3|.
+    """
+    ratios = [(syms.l0 + kin.lambda21) / syms.l0 for kin in kinematics.values()]
+    return prog.define("reach", sp.Min(*ratios), STEP_POSE)

@@ -27,7 +27,7 @@ from rpr3gen_derive.codegen.spec import (
 )
 from rpr3gen_derive.rpr3 import symbols as syms
 from rpr3gen_derive.rpr3.dynamics import leg_wrenches
-from rpr3gen_derive.rpr3.kinematics import leg_kinematics, platform_rotation
+from rpr3gen_derive.rpr3.kinematics import leg_kinematics, platform_rotation, reach
 from rpr3gen_derive.rpr3.symbols import LEGS, PARAM_NAMES
 from rpr3gen_derive.rpr3.virtual_work import joint_loads
 
@@ -69,6 +69,12 @@ SAMPLE_OUTPUTS: tuple[OutputFamily, ...] = (
         "conditioning",
         "1",
         "closeness to a parallel singularity, 0 (singular) to 1 (see virtual_work.conditioning)",
+    ),
+    OutputFamily(
+        "reach",
+        "1",
+        "min over legs of (l0 + lambda21) / l0: 1 central, <= 0 with a piston joint on or behind "
+        "its base pivot (see kinematics.reach)",
     ),
 )
 
@@ -132,6 +138,7 @@ def derive(actuation: str) -> tuple[Program, dict[str, sp.Expr]]:
         for name in ("eps10", "gamma21", "eps32"):
             values[f"{name}_{leg}"] = getattr(kin, name)
     values.update(loads)
+    values["reach"] = reach(prog, kinematics)
     for name in OUTPUT_NAMES:  # the load of the free joint: m10 or f21z, identically zero
         values.setdefault(name, sp.Integer(0))
     return prog, {name: values[name] for name in OUTPUT_NAMES}
@@ -176,12 +183,19 @@ RETURN_CODES: tuple[ReturnCode, ...] = (
     ReturnCode(
         "SINGULAR",
         2,
-        "singular or degenerate pose: conditioning below the floor below, or a result that "
-        "would not be finite",
+        "singular or degenerate pose: a piston joint on or behind its base pivot (reach below "
+        "MIN_REACH), conditioning below MIN_CONDITIONING, or a result that would not be finite",
     ),
 )
 
 THRESHOLDS: tuple[Threshold, ...] = (
+    Threshold(
+        "MIN_REACH",
+        "1e-9",
+        'Output "reach" (min over legs of |A1A2| / l0; 1 in the central configuration) under '
+        "which a pose is refused: a piston joint on or behind its base pivot, which also keeps "
+        "every leg clear of the serial singularity |A1A3| = 0.",
+    ),
     Threshold(
         "MIN_CONDITIONING",
         "1e-9",
@@ -195,6 +209,7 @@ THRESHOLDS: tuple[Threshold, ...] = (
 #: The failure conditions of a function of the pose, in the order they are tested.
 SINGULAR_POSE_CHECKS: tuple[Check, ...] = (
     Check("inputs_not_finite", "NOT_FINITE"),
+    Check("below", "SINGULAR", "out", "reach", "MIN_REACH"),
     Check("below", "SINGULAR", "out", "conditioning", "MIN_CONDITIONING"),
     Check("outputs_not_finite", "SINGULAR"),
 )

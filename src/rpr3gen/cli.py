@@ -106,8 +106,8 @@ def _screen(
     allow_invalid: bool,
 ) -> None:
     """Refuse a trajectory through an invalid pose, or blank those rows when allowed."""
-    floor = manifest.load(model.actuation, model.generated).thresholds["MIN_CONDITIONING"]
-    invalid = invalid_samples(model, out, min_conditioning, singular_below=floor)
+    thresholds = manifest.load(model.actuation, model.generated).thresholds
+    invalid = invalid_samples(model, traj.q, out, min_conditioning, thresholds)
     if invalid is None:
         return
     if not allow_invalid:

@@ -88,20 +88,37 @@ class Invalid:
     reason: str  # one line, without the time
 
 
+def leg_extensions(model: Model, q: np.ndarray) -> np.ndarray:
+    """``|A1A2| = l0 + lambda21`` of each leg (m), (n, 3), straight from the geometry (eq. 5).
+
+    For messages about poses the generated code refused (whose outputs are NaN).
+    """
+    p = model.params
+    c, s = np.cos(q[:, 2]), np.sin(q[:, 2])
+    columns = []
+    for leg in LEGS:
+        x3 = q[:, 0] + c * p[f"x{leg}3"] - s * p[f"y{leg}3"] - p[f"x{leg}1"]
+        y3 = q[:, 1] + s * p[f"x{leg}3"] + c * p[f"y{leg}3"] - p[f"y{leg}1"]
+        columns.append(np.hypot(x3, y3) - p["l2"])
+    return np.stack(columns, axis=1)
+
+
 def invalid_samples(
     model: Model,
+    q: np.ndarray,
     out: Mapping[str, np.ndarray],
     min_conditioning: float,
-    singular_below: float,
+    thresholds: Mapping[str, float],
 ) -> Invalid | None:
     """Samples that are singular, too close to a singularity, or outside a stroke limit.
 
     Args:
         model: the robot (its stroke limits).
-        out: the inverse dynamics' outputs.
+        q: (n, 3) the poses.
+        out: the inverse dynamics' outputs (NaN where the generated code refused the sample).
         min_conditioning: refuse ``conditioning`` below this.
-        singular_below: the generated code's own floor (``MIN_CONDITIONING`` of the manifest),
-            under which a pose is reported as singular rather than as too close.
+        thresholds: the generated code's own floors (``MIN_CONDITIONING``, ``MIN_REACH`` of the
+            manifest), to say why it refused a sample.
     """
     conditioning = out["conditioning"]
     with np.errstate(invalid="ignore"):
@@ -117,9 +134,21 @@ def invalid_samples(
         return None
     first = int(np.argmax(mask))
     if singular[first]:
+        extension = leg_extensions(model, q[first : first + 1])[0]
+        k = int(np.argmin(extension))
         c = conditioning[first]
-        what = "a singular pose" if not c >= singular_below else f"conditioning {c:.3g}"
-        reason = f"{what}, under the threshold {min_conditioning:g} (too close to a singularity)"
+        if not extension[k] >= thresholds["MIN_REACH"] * model.params["l0"]:
+            reason = (
+                f"leg {LEGS[k]}: its piston joint {LEGS[k]}2 is on or behind its base pivot "
+                f"{LEGS[k]}1 (l0 + lambda21_{LEGS[k]} = {extension[k]:.6g} m), where the leg "
+                "folds onto the serial singularity |A1A3| = 0"
+            )
+        else:
+            floor = thresholds["MIN_CONDITIONING"]
+            what = "a singular pose" if not c >= floor else f"conditioning {c:.3g}"
+            reason = (
+                f"{what}, under the threshold {min_conditioning:g} (too close to a singularity)"
+            )
     else:
         assert model.stroke is not None
         leg = next(leg for leg, leg_mask in outside.items() if leg_mask[first])

@@ -121,6 +121,13 @@ class _Lowering:
             self.lines.append(f"numpy.rint({turns}, out={turns})")
             self.lines.append(f"numpy.multiply({turns}, {TWO_PI}, out={turns})")
             return self.call("subtract", [x, turns], dest)
+        if expr.func in (sp.Min, sp.Max):  # n-ary: folded pairwise
+            ufunc = "fmin" if expr.func is sp.Min else "fmax"
+            acc = self.emit(expr.args[0])
+            for k, arg in enumerate(expr.args[1:]):
+                final = k == len(expr.args) - 2
+                acc = self.call(ufunc, [acc, self.emit(arg)], dest if final else None)
+            return acc
         if expr.func in _UFUNC:
             args = [self.emit(a) for a in expr.args]
             return self.call(_UFUNC[expr.func], args, dest)
