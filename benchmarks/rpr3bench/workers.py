@@ -70,8 +70,8 @@ class StageTimer:
                     self.seconds[variant_name]["total"] += elapsed
             else:
                 self.seconds[self.current][name] += elapsed - inner
-                if self._nested:
-                    self._nested[-1] += elapsed
+            if self._nested:
+                self._nested[-1] += elapsed
 
     def result(self) -> dict[str, dict[str, float]]:
         return {v: dict(stages) for v, stages in self.seconds.items()}
