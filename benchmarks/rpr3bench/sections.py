@@ -586,7 +586,8 @@ def _newton_euler(quick: bool, numpy_results: dict[str, Any]) -> tuple[str, dict
         'backend="numpy")` and the generated function in one call, on the same samples in one '
         f"process (best of {len(ne['sizes'][0]['ne'])}); the difference column compares the "
         f"{ne['sizes'][0]['compared']} outputs both give (backend against Newton–Euler, "
-        "relative to max(1, |value|)).\n"
+        "relative to max(1, |value|)). The parameters of `newton_euler.paper_params()` and of "
+        f"`load_model()` differ by at most {ne['param_diff']:.1e}.\n"
     )
     return text, result
 
