@@ -1,6 +1,7 @@
-/* C timing harness of rpr3gen's generated inverse dynamics (run by benchmarks/run.py).
+/* C timing harness of rpr3gen's generated inverse dynamics (run by benchmarks/run.py,
+ * through benchmarks/rpr3bench/charness.py).
  *
- * Build (from the repository root), as run.py does:
+ * Build (from the repository root), as the harness does:
  *   cc -std=c99 -O3 -march=native -I generated/revolute benchmarks/bench.c \
  *      generated/revolute/rpr3.c -lm -o bench
  *
@@ -24,8 +25,10 @@
  *   floor_gen_ns        the floor plus the sin and cos of alpha_A, alpha_B, alpha_C per sample
  *                       (4 sin, 4 cos, 3 sqrt, 3 atan2): what parameter trigonometry evaluated
  *                       per sample costs, as earlier generated code did
- *   single_ns           rpr3_inverse_dynamics called once per sample, out a 51-double buffer
- *   batch_ns            rpr3_inverse_dynamics_batch over all N samples (N x 51 output)
+ *   single_ns           rpr3_inverse_dynamics called once per sample, out one buffer of
+ *                       RPR3_NUM_OUTPUTS doubles
+ *   batch_ns            rpr3_inverse_dynamics_batch over all N samples (N x RPR3_NUM_OUTPUTS
+ *                       output)
  *   batch_small_ns      rpr3_inverse_dynamics_batch over the first 1000 samples, repeated to
  *                       cover N samples: the output stays in cache (no memory streaming)
  */
@@ -87,7 +90,8 @@ static int read_params(const char *path, double *params)
     return 0;
 }
 
-/* FLOOR BEGIN: run.py looks for compiler vectorisation remarks between these markers. */
+/* FLOOR BEGIN: rpr3bench/charness.py looks for compiler vectorisation remarks between these
+ * markers. */
 
 /* One sin and one cos of phi, and per leg the length (sqrt) and direction (atan2) of the leg
  * vector A1 -> A3 = G + R(phi) p - A1, as the generated code forms them. */

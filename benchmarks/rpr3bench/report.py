@@ -1,0 +1,270 @@
+"""The report: Markdown tables and number formats, the machine block, the targets and verdicts.
+
+Every figure of a report is measured in the same run; the machine block says where and when,
+and warns when the generated code changed while the run was going on.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import datetime as dt
+import importlib.metadata
+import os
+import platform
+import subprocess
+from collections import defaultdict
+from collections.abc import Sequence
+from typing import Any
+
+from rpr3bench.common import CC, CODE_IDS, REPO, VARIANT, shown, variant
+
+#: Goals of the project, scored in the report's first table.
+TARGETS = {
+    "c_batch_floor": 1.2,  # C batch ns/sample <= 1.2 x the scalar floor
+    "c_single_floor": 2.0,  # C single call <= 2 x the scalar floor
+    "numpy_vs_ne": 20.0,  # NumPy batch >= 20 x faster than the Newton-Euler solve
+    "numpy_1e6_ns": 500.0,  # NumPy at 10^6 samples < 500 ns/sample
+    "python_single_us": 1.0,  # SampleEvaluator call < 1 us
+    "regeneration_s": 5.0,  # full regeneration < 5 s
+}
+#: The function the targets score.
+SCORED = "inverse_dynamics"
+
+
+# ---------------------------------------------------------------------------------------------
+# Tables and numbers
+# ---------------------------------------------------------------------------------------------
+
+
+def table(header: Sequence[str], rows: Sequence[Sequence[Any]]) -> str:
+    cells = [[str(c) for c in header]] + [[str(c) for c in row] for row in rows]
+    widths = [max(len(row[k]) for row in cells) for k in range(len(header))]
+    lines = ["| " + " | ".join(c.ljust(w) for c, w in zip(cells[0], widths, strict=True)) + " |"]
+    lines.append("|" + "|".join("-" * (w + 2) for w in widths) + "|")
+    for row in cells[1:]:
+        lines.append("| " + " | ".join(c.ljust(w) for c, w in zip(row, widths, strict=True)) + " |")
+    return "\n".join(lines)
+
+
+def ns(value: float | None) -> str:
+    if value is None:
+        return "n/a"
+    return f"{value:,.0f}" if value >= 1000 else f"{value:.1f}"
+
+
+def secs(value: float | None) -> str:
+    return "n/a" if value is None else f"{value:.3f}"
+
+
+def mb(value: float | None) -> str:
+    return "n/a" if value is None else f"{value / 1e6:,.0f}"
+
+
+def ratio(value: float | None) -> str:
+    if value is None:
+        return "n/a"
+    return f"{value:.2f}x" if value < 100 else f"{value:,.0f}x"
+
+
+def median(values: Sequence[float]) -> float:
+    ordered = sorted(values)
+    mid = len(ordered) // 2
+    return ordered[mid] if len(ordered) % 2 else 0.5 * (ordered[mid - 1] + ordered[mid])
+
+
+def size_label(n: int) -> str:
+    exponent = len(str(n)) - 1
+    return f"10^{exponent}" if n == 10**exponent else f"{n:,}"
+
+
+# ---------------------------------------------------------------------------------------------
+# The machine
+# ---------------------------------------------------------------------------------------------
+
+
+def _command_output(command: Sequence[str]) -> str:
+    try:
+        done = subprocess.run(command, capture_output=True, text=True, check=False, cwd=REPO)
+    except OSError:
+        return "n/a"
+    return (done.stdout.strip().splitlines() or ["n/a"])[0]
+
+
+def loadavg() -> str:
+    with open("/proc/loadavg") as handle:
+        return " ".join(handle.read().split()[:3]) + " (1, 5, 15 min)"
+
+
+def machine() -> dict[str, str]:
+    model = "unknown"
+    with contextlib.suppress(OSError), open("/proc/cpuinfo") as handle:
+        for line in handle:
+            if line.startswith("model name"):
+                model = line.split(":", 1)[1].strip()
+                break
+    lscpu = _command_output(["sh", "-c", "lscpu | grep -i 'model name'"])
+    if lscpu != "n/a" and ":" in lscpu:
+        model_lscpu = lscpu.split(":", 1)[1].strip()
+        if model_lscpu and model_lscpu != model:
+            model = f"{model} (lscpu: {model_lscpu})"
+    mem_total = "n/a"
+    with contextlib.suppress(OSError), open("/proc/meminfo") as handle:
+        for line in handle:
+            if line.startswith("MemTotal:"):
+                mem_total = f"{int(line.split()[1]) / 1024**2:.1f} GiB"
+    found = variant()
+    dirty = _command_output(
+        ["sh", "-c", "git status --porcelain -- derive generated src | wc -l"]
+    ).strip()
+
+    def version(package: str) -> str:
+        try:
+            return importlib.metadata.version(package)
+        except importlib.metadata.PackageNotFoundError:
+            return "not installed"
+
+    return {
+        "date": dt.datetime.now(dt.UTC).strftime("%Y-%m-%d %H:%M:%S UTC"),
+        "cpu": model,
+        "cores": f"{os.cpu_count()} logical, {len(os.sched_getaffinity(0))} usable",
+        "memory": mem_total,
+        "os": f"{platform.system()} {platform.release()} ({platform.machine()})",
+        "python": platform.python_version(),
+        "numpy": version("numpy"),
+        "sympy": version("sympy"),
+        "jinja2": version("jinja2"),
+        "compiler": _command_output([*CC, "--version"]),
+        "libc": " ".join(platform.libc_ver()),
+        "git": _command_output(["git", "rev-parse", "--short", "HEAD"])
+        + f" ({dirty} uncommitted paths in derive/ generated/ src/)",
+        "generated code": f"{shown(found.folder)}, functions: {', '.join(found.functions)}",
+        "generated source hash": found.source_hash[:16],
+        "load average (start)": loadavg(),
+    }
+
+
+# ---------------------------------------------------------------------------------------------
+# Targets
+# ---------------------------------------------------------------------------------------------
+
+
+def verdict(measured: float | None, limit: float, at_most: bool = True) -> tuple[str, str]:
+    """("pass"/"miss", margin text) for measured <= limit (or >= limit)."""
+    if measured is None:
+        return "n/a", "not measured"
+    factor = measured / limit if at_most else limit / measured
+    if factor <= 1.0:
+        return "**pass**", f"{1 / factor:.2f}x headroom"
+    return "**miss**", f"{factor:.2f}x over"
+
+
+def targets(results: dict[str, Any]) -> str:
+    """The targets table, from the results of every section."""
+    c = results.get("c", {})
+    floor = c.get("floor_ns")
+    rows = []
+
+    def add(
+        name: str,
+        measured_text: str,
+        measured: float | None,
+        limit: float,
+        limit_text: str,
+        at_most: bool = True,
+    ) -> None:
+        status, margin = verdict(measured, limit, at_most)
+        rows.append([name, measured_text, limit_text, status, margin])
+
+    if floor:
+        b = c["batch_ns"] / floor
+        s = c["single_ns"] / floor
+        add(
+            "C batch vs scalar floor",
+            f"{ns(c['batch_ns'])} / {ns(floor)} ns = {ratio(b)}",
+            b,
+            TARGETS["c_batch_floor"],
+            "≤ 1.2x",
+        )
+        add(
+            "C single call vs scalar floor",
+            f"{ns(c['single_ns'])} / {ns(floor)} ns = {ratio(s)}",
+            s,
+            TARGETS["c_single_floor"],
+            "≤ 2x",
+        )
+    for n, value in sorted(results.get("peers", {}).get("ne_ratio", {}).items()):
+        add(
+            f"NumPy vs Newton–Euler, {size_label(n)}",
+            f"{ratio(value)} faster",
+            value,
+            TARGETS["numpy_vs_ne"],
+            "≥ 20x faster",
+            at_most=False,
+        )
+    backend = results.get("numpy", {}).get(SCORED, {}).get("backend", {})
+    n6 = backend.get(10**6, {}).get("best_ns")
+    add(
+        "NumPy at 10^6 samples",
+        f"{ns(n6)} ns/sample",
+        n6,
+        TARGETS["numpy_1e6_ns"],
+        "< 500 ns/sample",
+    )
+    py = results.get("python", {}).get("functions", {}).get(SCORED, {}).get("c_call")
+    add(
+        "Python single call (`SampleEvaluator`)",
+        f"{py * 1e6:.3f} µs" if py else "n/a",
+        py * 1e6 if py else None,
+        TARGETS["python_single_us"],
+        "< 1 µs",
+    )
+    regen = results.get("regen", {})
+    add(
+        "full regeneration, `rpr3gen generate --check`",
+        f"{secs(regen.get('cli'))} s",
+        regen.get("cli"),
+        TARGETS["regeneration_s"],
+        "< 5 s",
+    )
+    add(
+        "full regeneration, `generate.render()` in process",
+        f"{secs(regen.get('total'))} s",
+        regen.get("total"),
+        TARGETS["regeneration_s"],
+        "< 5 s",
+    )
+    return table(["target", "measured", "goal", "result", "margin"], rows) + "\n"
+
+
+# ---------------------------------------------------------------------------------------------
+# The document
+# ---------------------------------------------------------------------------------------------
+
+
+def document(
+    command: str,
+    info: dict[str, str],
+    results: dict[str, Any],
+    sections: Sequence[tuple[str, str]],
+) -> str:
+    """The whole report: machine block, a warning if the code changed, targets, sections."""
+    ids = sorted({cid for _, cid in CODE_IDS if cid})
+    info = {**info, "generated code id": ids[0] if len(ids) == 1 else "**changed during the run**"}
+    lines = ["# rpr3gen benchmarks", "", f"`{command}`", ""]
+    if len(ids) > 1:
+        seen: dict[str, list[str]] = defaultdict(list)
+        for label, cid in CODE_IDS:
+            if label not in seen[cid]:
+                seen[cid].append(label)
+        lines.append(
+            f"**Warning: generated/{VARIANT} changed while this run was going on**; figures "
+            "measured on different code are not comparable. Code id (SHA-256 of the variant's "
+            "manifest.json and generated sources) seen by each measurement:\n"
+        )
+        lines += [f"- `{cid}`: {'; '.join(labels)}" for cid, labels in seen.items()]
+        lines.append("")
+    lines.append(table(["machine", ""], [[k, v] for k, v in info.items()]))
+    lines += ["", "## Targets", "", targets(results)]
+    for title, body in sections:
+        lines += [f"## {title}", "", body]
+    return "\n".join(lines).rstrip() + "\n"

@@ -1,0 +1,482 @@
+"""The measurements that run in a fresh interpreter, and the parent's side that starts them.
+
+Each worker takes a dict of arguments and returns a JSON-able dict; :func:`run_worker` starts
+``python benchmarks/run.py --worker NAME --args JSON`` and reads the result from the last line
+of its stdout. A fresh interpreter keeps caches cold (regeneration) and one measurement's memory
+out of another's (each NumPy size).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+import resource
+import subprocess
+import time
+import timeit
+from collections import defaultdict
+from collections.abc import Callable, Iterator
+from typing import Any
+
+from rpr3bench.common import (
+    BENCH,
+    CODE_IDS,
+    PY,
+    REPO,
+    VARIANT,
+    code_id,
+    sample_inputs,
+    variant,
+)
+
+SHARED = "shared"  # the stages of regeneration outside any variant
+
+
+class StageTimer:
+    """The engine's stage hook: seconds per (variant, stage), from the nesting of stages.
+
+    ``render(stage=timer.stage)`` enters ``"variant:NAME"`` around the work on one variant and
+    the stages ``"derive"``, ``"cse"``, ``"print"`` and ``"render"`` inside it (outside any
+    variant they count as :data:`SHARED`). A stage may be entered several times; its time is
+    what it spends outside the stages nested in it, so no second is counted twice. ``"total"``
+    of a variant is its wall time in ``"variant:NAME"``.
+    """
+
+    def __init__(self) -> None:
+        self.seconds: dict[str, dict[str, float]] = defaultdict(lambda: defaultdict(float))
+        self._variants: list[str] = []
+        self._nested: list[float] = []  # per open stage: seconds of the stages inside it
+
+    @property
+    def current(self) -> str:
+        return self._variants[-1] if self._variants else SHARED
+
+    @contextlib.contextmanager
+    def stage(self, name: str) -> Iterator[None]:
+        is_variant = name.startswith("variant:")
+        if is_variant:
+            self._variants.append(name.removeprefix("variant:"))
+        self._nested.append(0.0)
+        start = time.perf_counter()
+        try:
+            yield
+        finally:
+            elapsed = time.perf_counter() - start
+            inner = self._nested.pop()
+            if is_variant:
+                variant_name = self._variants.pop()
+                if variant_name not in self._variants:  # outermost entry of this variant
+                    self.seconds[variant_name]["total"] += elapsed
+            else:
+                self.seconds[self.current][name] += elapsed - inner
+            if self._nested:
+                self._nested[-1] += elapsed
+
+    def result(self) -> dict[str, dict[str, float]]:
+        return {v: dict(stages) for v, stages in self.seconds.items()}
+
+
+def worker_regen(_: dict[str, Any]) -> dict[str, Any]:
+    """One cold regeneration (``generate.render()``, both actuations), timed by stage.
+
+    Afterwards (not timed) every function is compiled again for its op counts.
+    """
+    t0 = time.perf_counter()
+    from rpr3gen_derive.codegen.files import stale_files
+    from rpr3gen_derive.codegen.render import compile_function
+    from rpr3gen_derive.rpr3 import generate, registry
+
+    imports = time.perf_counter() - t0
+    registry.clear_cache()
+    timer = StageTimer()
+    start = time.perf_counter()
+    files = generate.render(stage=timer.stage)
+    total = time.perf_counter() - start
+    out_dir = generate.default_out_dir()
+    ops: dict[str, dict[str, dict[str, int]]] = {}
+    for actuation in registry.ACTUATIONS:
+        module = registry.module(actuation)  # the specs derived above, from the cache
+        ops[actuation] = {}
+        for spec in module.functions:
+            code = compile_function(spec, module.params).code
+            ops[actuation][spec.name] = {
+                "before": int(code.ops_before),
+                "after": int(code.ops_after),
+                "assignments": len(code.assignments),
+            }
+    return {
+        "imports": imports,
+        "total": total,
+        "times": timer.result(),
+        "ops": ops,
+        "files": len(files),
+        "stale": stale_files(out_dir, files) if out_dir is not None else None,
+    }
+
+
+# ---------------------------------------------------------------------------------------------
+# Memory of this process
+# ---------------------------------------------------------------------------------------------
+
+
+def _rss_bytes() -> int:
+    with open("/proc/self/statm") as handle:
+        return int(handle.read().split()[1]) * os.sysconf("SC_PAGE_SIZE")
+
+
+def _peak_rss_bytes() -> int:
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024  # Linux: kilobytes
+
+
+# ---------------------------------------------------------------------------------------------
+# The generated NumPy code, as users call it and on its own
+# ---------------------------------------------------------------------------------------------
+
+
+class NumpyCalls:
+    """One function of the measured variant, through the NumPy backend and directly.
+
+    ``backend(*inputs)``: ``rpr3gen.evaluate(model, name, inputs, backend="numpy")``, the
+    public call (it allocates the outputs, evaluates in blocks of ``rpr3gen.backends.BLOCK``
+    samples and applies the failure policy). ``direct(*inputs, *outputs)``: the generated
+    function ``numpy_function(params, inputs..., outputs...)`` of the generated module, outputs
+    (size, n) preallocated by the caller (:meth:`allocate`).
+    """
+
+    def __init__(self, name: str) -> None:
+        import rpr3gen
+        from rpr3gen.evaluators import numpy_module
+
+        self.model = rpr3gen.load_model()
+        self.variant = variant()
+        self.info = self.variant.function(name)
+        self.params = self.model.vector(self.variant.param_names)
+        self.module = numpy_module(self.variant)
+        self.function = getattr(self.module, self.info.numpy_function)
+        self.sizes = [o.size for o in self.info.outputs]
+        self._evaluate = rpr3gen.evaluate
+
+    def backend(self, *inputs: Any) -> list[Any]:
+        outputs, _ = self._evaluate(self.model, self.info.name, inputs, backend="numpy")
+        return outputs
+
+    def allocate(self, n: int) -> list[Any]:
+        import numpy as np
+
+        return [np.empty((size, n)) for size in self.sizes]
+
+    def direct(self, inputs: list[Any], outputs: list[Any]) -> None:
+        self.function(self.params, *inputs, *outputs)
+
+    def named(self, outputs: list[Any]) -> dict[str, Any]:
+        """``{component name: (n,) array}`` of outputs from :meth:`backend`."""
+        return {
+            name: out[:, k]
+            for info, out in zip(self.info.outputs, outputs, strict=True)
+            for k, name in enumerate(info.names)
+        }
+
+
+def worker_numpy(args: dict[str, Any]) -> dict[str, Any]:
+    """NumPy at one size: best time, peak RSS and tracemalloc peak of one call.
+
+    ``mode`` "backend": the public ``rpr3gen.evaluate(..., backend="numpy")``; "direct": the
+    generated function in one call over all samples (``chunk``: in calls of that many) into
+    preallocated outputs.
+    """
+    import tracemalloc
+
+    n, repeats, chunk = int(args["n"]), int(args["repeats"]), args.get("chunk")
+    limit = int(args["mem_limit"])
+    resource.setrlimit(resource.RLIMIT_AS, (limit, limit))  # fail with MemoryError, not the OOM
+    calls = NumpyCalls(args["function"])
+    warm = sample_inputs(calls.info, 1000)
+    calls.direct(warm, calls.allocate(1000))  # import and warm up the code paths
+    calls.backend(*warm)
+    inputs = sample_inputs(calls.info, n)
+    direct = args["mode"] == "direct"
+    outputs = calls.allocate(n if direct else 0)
+    for out in outputs:
+        out.fill(0.0)  # touch the output pages before timing
+    rss_before = _rss_bytes()
+    step = int(chunk) if chunk else n
+
+    def call(stop: int = n) -> None:
+        if not direct:
+            calls.backend(*(a[:stop] for a in inputs))
+            return
+        for a in range(0, stop, step):
+            b = min(stop, a + step)
+            calls.direct([x[a:b] for x in inputs], [out[:, a:b] for out in outputs])
+
+    times = []
+    usage = resource.getrusage(resource.RUSAGE_SELF)
+    for _ in range(repeats):
+        start = time.perf_counter()
+        call()
+        times.append(time.perf_counter() - start)
+    after = resource.getrusage(resource.RUSAGE_SELF)
+    peak_rss = _peak_rss_bytes()
+    tracemalloc.start()
+    call(step)
+    _, traced_peak = tracemalloc.get_traced_memory()
+    tracemalloc.stop()
+    return {
+        "function": calls.info.name,
+        "n": n,
+        "mode": args["mode"],
+        "chunk": step if chunk else None,
+        "times": times,
+        "rss_before": rss_before,
+        "peak_rss": peak_rss,
+        "traced_peak": traced_peak,
+        "traced_samples": step,
+        "minor_faults": after.ru_minflt - usage.ru_minflt,
+        "user": after.ru_utime - usage.ru_utime,
+        "system": after.ru_stime - usage.ru_stime,
+        "outputs": sum(calls.sizes),
+        "inputs": sum(a.size for a in calls.info.inputs),
+    }
+
+
+def _relative_difference(got: dict[str, Any], ref: dict[str, Any]) -> tuple[float, int]:
+    """Largest |got - ref| / max(1, max |ref|) over the names both have, and how many."""
+    import numpy as np
+
+    worst, compared = 0.0, 0
+    for name, value in got.items():
+        if name not in ref:
+            continue
+        compared += 1
+        scale = max(1.0, float(np.max(np.abs(ref[name]))))
+        worst = max(worst, float(np.max(np.abs(value - ref[name]))) / scale)
+    return worst, compared
+
+
+# ---------------------------------------------------------------------------------------------
+# Peers
+# ---------------------------------------------------------------------------------------------
+
+
+def _import_newton_euler() -> Any:
+    import importlib.util
+
+    path = REPO / "tests" / "newton_euler.py"
+    spec = importlib.util.spec_from_file_location("rpr3_bench_newton_euler", path)
+    assert spec is not None
+    assert spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def worker_newton_euler(args: dict[str, Any]) -> dict[str, Any]:
+    """The reference Newton-Euler batched solve against the NumPy backend, interleaved."""
+    ne = _import_newton_euler()
+    ne_params = ne.paper_params()
+    calls = NumpyCalls("inverse_dynamics")
+    param_diff = max(abs(ne_params[k] - calls.model.params[k]) for k in ne_params)
+    results = []
+    for n in args["sizes"]:
+        q, qd, qdd = sample_inputs(calls.info, n)
+        outputs = calls.allocate(n)
+        t_ne, t_np, t_direct = [], [], []
+        ref, got = {}, {}
+        for _ in range(int(args["repeats"])):
+            start = time.perf_counter()
+            ref = ne.solve(ne_params, VARIANT, q, qd, qdd)
+            t_ne.append(time.perf_counter() - start)
+            start = time.perf_counter()
+            got = calls.named(calls.backend(q, qd, qdd))
+            t_np.append(time.perf_counter() - start)
+            start = time.perf_counter()
+            calls.direct([q, qd, qdd], outputs)
+            t_direct.append(time.perf_counter() - start)
+        worst, compared = _relative_difference(got, ref)
+        results.append(
+            {
+                "n": n,
+                "ne": t_ne,
+                "numpy": t_np,
+                "direct": t_direct,
+                "max_rel_diff": worst,
+                "compared": compared,
+            }
+        )
+    return {"sizes": results, "param_diff": param_diff}
+
+
+def worker_lambdify(args: dict[str, Any]) -> dict[str, Any]:
+    """``sympy.lambdify`` (numpy, no CSE) of one function's fully expanded outputs, against the
+    NumPy backend."""
+    import numpy as np
+    import sympy as sp
+    from rpr3gen_derive.codegen.backends.python.printer import NumpyPrinter
+    from rpr3gen_derive.rpr3 import registry
+
+    name = args["function"]
+    module = registry.module(VARIANT)
+    spec = next(f for f in module.functions if f.name == name)
+    flat = spec.flat_outputs()
+    start = time.perf_counter()
+    expanded = [spec.program.expand(expr) for _, _, expr in flat]
+    t_expand = time.perf_counter() - start
+    arguments = [*module.params.symbols, *(s for arg in spec.inputs for s in arg.symbols)]
+    # The derivation uses functions of its own (``wrap_angle``); the project's NumPy printer
+    # (SymPy's, plus those) prints them. Everything else is plain lambdify.
+    printer = NumpyPrinter()
+    start = time.perf_counter()
+    func = sp.lambdify(arguments, expanded, modules="numpy", cse=False, printer=printer)
+    t_lambdify = time.perf_counter() - start
+    expanded_ops = sum(int(sp.count_ops(e)) for e in expanded)
+
+    n = int(args["n"])
+    calls = NumpyCalls(name)
+    if [str(s) for s in module.params.symbols] != list(calls.variant.param_names):
+        raise RuntimeError("the registry's parameters and the manifest's differ in order")
+    inputs = sample_inputs(calls.info, n)
+    values = [float(v) for v in calls.params] + [a[:, k] for a in inputs for k in range(a.shape[1])]
+    start = time.perf_counter()
+    result = func(*values)
+    t_first = time.perf_counter() - start
+    t_lam, t_gen = [], []
+    got: list[Any] = []
+    for _ in range(int(args["repeats"])):
+        start = time.perf_counter()
+        func(*values)
+        t_lam.append(time.perf_counter() - start)
+        start = time.perf_counter()
+        got = calls.backend(*inputs)
+        t_gen.append(time.perf_counter() - start)
+    index = {o.name: k for k, o in enumerate(spec.outputs)}
+    lam = {
+        f"{o}[{k}]": np.broadcast_to(np.asarray(value, dtype=float), (n,))
+        for (o, k, _), value in zip(flat, result, strict=True)
+    }
+    gen = {f"{o}[{k}]": got[index[o]][:, k] for o, k, _ in flat}
+    worst, compared = _relative_difference(lam, gen)
+    return {
+        "function": name,
+        "n": n,
+        "printer": f"{type(printer).__module__}.{type(printer).__name__}",
+        "outputs": len(expanded),
+        "compared": compared,
+        "expand": t_expand,
+        "lambdify": t_lambdify,
+        "expanded_ops": expanded_ops,
+        "first_call": t_first,
+        "lambdified": t_lam,
+        "generated": t_gen,
+        "max_rel_diff": worst,
+        "peak_rss": _peak_rss_bytes(),
+    }
+
+
+# ---------------------------------------------------------------------------------------------
+# The Python single-sample call
+# ---------------------------------------------------------------------------------------------
+
+
+def worker_python_single(args: dict[str, Any]) -> dict[str, Any]:
+    """``SampleEvaluator`` calls of each function: the C backend, its ctypes floor, NumPy."""
+    import numpy as np
+
+    import rpr3gen
+    from rpr3gen import cbackend
+
+    model = rpr3gen.load_model()
+    number, repeats = int(args["number"]), int(args["repeats"])
+    mid = 150
+
+    def best(func: Callable[[], Any], count: int) -> float:
+        return min(timeit.repeat(func, number=count, repeat=repeats)) / count
+
+    def empty() -> None:
+        pass
+
+    results = {}
+    for name in args["functions"]:
+        evaluator = rpr3gen.SampleEvaluator(model, backend="c", function=name)
+        sample = [a[mid] for a in sample_inputs(evaluator.function, 301)]
+        for buffer, value in zip(evaluator.inputs.values(), sample, strict=True):
+            buffer[:] = value
+        status = evaluator()
+        # The same entry point with a NaN input returns at the first check (inputs not
+        # finite): what is left of its time is the cost of getting into C and back (ctypes,
+        # interpreter).
+        rejected = rpr3gen.SampleEvaluator(model, backend="c", function=name)
+        next(iter(rejected.inputs.values()))[:] = np.nan
+        rejected_status = rejected()
+        slow = rpr3gen.SampleEvaluator(model, backend="numpy", function=name)
+        for buffer, value in zip(slow.inputs.values(), sample, strict=True):
+            buffer[:] = value
+        results[name] = {
+            "c_call": best(evaluator, number),
+            "c_rejected": best(rejected, number),
+            "c_evaluate": best(lambda ev=evaluator, s=sample: ev.evaluate(*s), number // 4),
+            "numpy_call": best(slow, max(10, int(args["numpy_number"]))),
+            "status": status,
+            "rejected_status": rejected_status,
+            "rejected_meaning": evaluator.codes.get(rejected_status, "?"),
+        }
+        slow()
+        results[name]["agree"] = all(
+            bool(np.allclose(evaluator.outputs[o], slow.outputs[o], rtol=1e-9, atol=1e-9))
+            for o in evaluator.outputs
+        )
+    return {
+        "functions": results,
+        "python_call": best(empty, number),
+        # The flags the runtime tries first (it drops extras the compiler refuses).
+        "cflags": [*cbackend.CFLAGS, *cbackend.EXTRA_FLAGS[0]],
+        "number": number,
+        "repeats": repeats,
+    }
+
+
+WORKERS: dict[str, Callable[[dict[str, Any]], dict[str, Any]]] = {
+    "regen": worker_regen,
+    "numpy": worker_numpy,
+    "newton_euler": worker_newton_euler,
+    "lambdify": worker_lambdify,
+    "python_single": worker_python_single,
+}
+
+
+def work(name: str, args: dict[str, Any]) -> dict[str, Any]:
+    """Run worker ``name`` in this process (``run.py --worker``), with the code ids it saw."""
+    before = code_id()
+    result = WORKERS[name](args)
+    result["code_ids"] = [before, code_id()]
+    return result
+
+
+def run_worker(
+    name: str, timeout: float = 900.0, env: dict[str, str] | None = None, **args: Any
+) -> dict[str, Any]:
+    """Run one worker in a fresh interpreter; return its JSON result (or an "error")."""
+    command = [PY, str(BENCH / "run.py"), "--worker", name, "--args", json.dumps(args)]
+    try:
+        done = subprocess.run(
+            command,
+            capture_output=True,
+            text=True,
+            timeout=timeout,
+            check=False,
+            cwd=REPO,
+            env={**os.environ, **(env or {})},
+        )
+    except subprocess.TimeoutExpired:
+        return {"error": f"timed out after {timeout:.0f} s"}
+    lines = done.stdout.strip().splitlines()
+    if done.returncode != 0 or not lines:
+        tail = (done.stderr.strip().splitlines() or ["(no message)"])[-1]
+        return {"error": f"exit status {done.returncode}: {tail}"}
+    result: dict[str, Any] = json.loads(lines[-1])
+    label = f"{name} " + ", ".join(f"{k}={v}" for k, v in args.items() if k != "mem_limit")
+    if env:
+        label += " (" + " ".join(f"{k}={v}" for k, v in env.items()) + ")"
+    if name != "regen":  # regeneration renders from derive/ and does not run generated/
+        CODE_IDS.extend((label.strip(), cid) for cid in result.get("code_ids", []))
+    return result
