@@ -49,7 +49,16 @@ def leg_lengths(actuation: str) -> FunctionSpec:
             ),
         ),
         program=prog,
-        checks=(Check("inputs_not_finite", "NOT_FINITE"),),
+        checks=(
+            Check("inputs_not_finite", "NOT_FINITE"),
+            # a value tested, not returned: the engine keeps it inside the C (a hidden output)
+            Check(
+                "below",
+                "SINGULAR",
+                threshold="MIN_REACH",
+                guard=("reach", (sp.Min(*lengths) - syms.l2) / syms.l0),
+            ),
+        ),
     )
 
 
@@ -90,19 +99,23 @@ def test_a_toy_spec_is_rendered_compiled_and_called_by_name(
     assert "int rpr3_leg_lengths(const double *params, const double q[3], double lengths[3]);" in (
         header
     )
+    assert [o.name for o in variant.function("leg_lengths").outputs] == ["lengths", "guards"]
     model = _model(actuation, toy_folder)
     rng = np.random.default_rng(7)
-    q = rng.uniform([-0.05, -0.05, -0.3], [0.05, 0.05, 0.3], size=(40, 3))
+    q = rng.uniform([-0.03, -0.03, -0.1], [0.03, 0.03, 0.1], size=(40, 3))
     q[3, 1] = np.nan
+    q[5] = (0.0, -0.3, 0.0)  # A3 on A1: the guard (reach) refuses it
     results = {}
     for backend in ("numpy", "c"):
         (lengths,), codes = rpr3gen.evaluate(model, "leg_lengths", (q,), backend=backend)
         results[backend] = lengths
         assert codes[3] == variant.return_codes["NOT_FINITE"]
-        assert np.count_nonzero(codes) == 1
-        assert np.isnan(lengths[3]).all()
+        assert codes[5] == variant.return_codes["SINGULAR"]
+        assert np.count_nonzero(codes) == 2
+        assert np.isnan(lengths[[3, 5]]).all()
     np.testing.assert_allclose(results["c"], results["numpy"], rtol=1e-14, atol=0)
-    ok = np.isfinite(q).all(axis=1)
+    ok = np.isfinite(results["numpy"]).all(axis=1)
+    assert ok.sum() == len(q) - 2
     np.testing.assert_allclose(
         results["numpy"][ok], _reference_lengths(model, q[ok]), rtol=1e-13, atol=0
     )

@@ -130,6 +130,7 @@ def manifest(module: ModuleSpec, digest: str, files: dict[str, str]) -> str:
                         "name": o.name,
                         "doc": o.doc,
                         "table": f"{prefix}_{o.table}" if o.table else None,
+                        "hidden": o.hidden,
                         "components": _components(o),
                     }
                     for o in f.outputs

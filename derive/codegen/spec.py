@@ -53,13 +53,18 @@ class Argument:
 
 @dataclass(frozen=True)
 class Output:
-    """An output array: one expression per component, in program symbols."""
+    """An output array: one expression per component, in program symbols.
+
+    A ``hidden`` output is not part of the C interface: the engine makes one, ``guards``, of the
+    values that checks test when they are not outputs (see :class:`Check`).
+    """
 
     name: str
     exprs: tuple[sp.Expr, ...]
     components: tuple[Component, ...]
     doc: str
     table: str | None = None
+    hidden: bool = False
 
     def __post_init__(self) -> None:
         if len(self.exprs) != len(self.components):
@@ -103,8 +108,14 @@ class Check:
     """A failure condition; the first that holds gives the function's return code.
 
     ``inputs_not_finite``: an input component is NaN or infinite.
-    ``below``: the output component ``output[component]`` is below the threshold (or NaN).
+    ``below``: a value is below the threshold (or NaN): the output component
+    ``output[component]``, or a ``guard`` value computed only for the check: its name and
+    expression (``guard=("conditioning", expr)``), which the engine gathers into the hidden output
+    ``guards`` of the function.
     ``outputs_not_finite``: an output component is NaN or infinite.
+
+    The batch functions report a failed sample as a row of NaN, so after the input check all the
+    checks of a function must give the same code (:class:`ModuleSpec` enforces it).
     """
 
     kind: CheckKind
@@ -112,6 +123,7 @@ class Check:
     output: str | None = None
     component: str | None = None
     threshold: str | None = None
+    guard: tuple[str, sp.Expr] | None = None
 
 
 @dataclass(frozen=True)
@@ -124,6 +136,29 @@ class FunctionSpec:
     outputs: tuple[Output, ...]
     program: Program
     checks: tuple[Check, ...] = ()
+
+    def __post_init__(self) -> None:
+        guards = [c.guard for c in self.checks if c.guard is not None]
+        if not guards:
+            return
+        hidden = Output(
+            "guards",
+            tuple(expr for _, expr in guards),
+            tuple(Component(name, "1", "value a failure condition tests") for name, _ in guards),
+            "values the failure conditions test (internal)",
+            hidden=True,
+        )
+        checks = tuple(
+            Check(c.kind, c.code, "guards", c.guard[0], c.threshold) if c.guard else c
+            for c in self.checks
+        )
+        object.__setattr__(self, "outputs", (*self.outputs, hidden))
+        object.__setattr__(self, "checks", checks)
+
+    @property
+    def public_outputs(self) -> tuple[Output, ...]:
+        """The outputs of the C interface (all but the hidden ones)."""
+        return tuple(o for o in self.outputs if not o.hidden)
 
     def output(self, name: str) -> Output:
         return next(o for o in self.outputs if o.name == name)
@@ -160,6 +195,9 @@ class ModuleSpec:
         if len(set(names)) != len(names):
             raise ValueError(f"functions defined twice in {names}")
         for function in self.functions:
+            later = {c.code for c in function.checks if c.kind != "inputs_not_finite"}
+            if len(later) > 1:
+                raise ValueError(f"{function.name}: checks after the input check differ in code")
             for check in function.checks:
                 if check.code not in codes:
                     raise ValueError(f"{function.name}: unknown return code {check.code!r}")

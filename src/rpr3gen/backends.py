@@ -97,8 +97,8 @@ def evaluate(
         progress: show a progress bar on stderr when it is a terminal (long runs).
 
     Returns:
-        The outputs, each seen as (n, size), and the (n,) return codes (0: ok). The outputs of a
-        failed sample are NaN, whatever the backend.
+        The outputs of the function's interface, each seen as (n, size), and the (n,) return
+        codes (0: ok). The outputs of a failed sample are NaN, whatever the backend.
     """
     variant = manifest.load(model.actuation, model.generated)
     info = variant.function(function)
@@ -115,8 +115,9 @@ def evaluate(
     outputs = ev.allocate(info, n)
     for block in _blocks(n, progress):
         ev.run(info, params, [a[block] for a in arrays], [o[block] for o in outputs])
-    codes = policy.apply(info, arrays, outputs)
-    return outputs, codes
+    codes = policy.apply(info, arrays, outputs, applied=ev.applies_checks)
+    public = [o for o, arg in zip(outputs, info.outputs, strict=True) if not arg.hidden]
+    return public, codes
 
 
 def inverse_dynamics(

@@ -69,7 +69,7 @@ def shim(variant: Variant) -> bytes:
     """C source of the one-pointer entry points, one per function of the manifest."""
     lines = [f'#include "{variant.files["c_header"]}"', ""]
     for f in variant.functions.values():
-        count = 1 + len(f.inputs) + len(f.outputs)
+        count = 1 + len(f.inputs) + len(f.public_outputs)
         args = ", ".join(
             f"({'const ' if k <= len(f.inputs) else ''}double *)a[{k}]" for k in range(count)
         )
@@ -142,7 +142,7 @@ class Library:
         self.cdll = ctypes.CDLL(str(library_path(variant)))
         self.entries: dict[str, Entry] = {}
         for name, f in variant.functions.items():
-            count = len(f.inputs) + len(f.outputs)
+            count = len(f.inputs) + len(f.public_outputs)
             single = getattr(self.cdll, f.c_symbol)
             single.restype = ctypes.c_int
             single.argtypes = [ctypes.c_void_p] * (1 + count)

@@ -24,9 +24,14 @@ BACKENDS: tuple[str, ...] = ("numpy", "c")
 
 
 class Evaluator(Protocol):
-    """Evaluates the functions of one generated variant."""
+    """Evaluates the functions of one generated variant.
+
+    ``applies_checks``: the backend applies the failure conditions itself (the generated C
+    does, writing NaN rows; see :func:`rpr3gen.policy.return_codes`).
+    """
 
     variant: Variant
+    applies_checks: bool
 
     def allocate(self, function: FunctionInfo, n: int) -> list[np.ndarray]:
         """Uninitialised outputs for n samples, each seen as (n, size)."""
@@ -62,6 +67,8 @@ def numpy_module(variant: Variant) -> ModuleType:
 class NumpyEvaluator:
     """The generated NumPy code; outputs are stored (size, n), so each output row is contiguous."""
 
+    applies_checks = False
+
     def __init__(self, variant: Variant) -> None:
         self.variant = variant
         self.module = numpy_module(variant)
@@ -81,7 +88,12 @@ class NumpyEvaluator:
 
 
 class CEvaluator:
-    """The generated C, through its batch functions; outputs are row-major (n, size)."""
+    """The generated C, through its batch functions; outputs are row-major (n, size).
+
+    Hidden outputs (the values the checks test) stay inside the C: they are allocated, NaN.
+    """
+
+    applies_checks = True
 
     def __init__(self, variant: Variant) -> None:
         from rpr3gen import cbackend
@@ -90,7 +102,8 @@ class CEvaluator:
         self.library = cbackend.library(variant)
 
     def allocate(self, function: FunctionInfo, n: int) -> list[np.ndarray]:
-        return [np.empty((n, o.size)) for o in function.outputs]
+        return [np.full((n, o.size), np.nan) if o.hidden else np.empty((n, o.size))
+                for o in function.outputs]  # fmt: skip
 
     def run(
         self,
@@ -99,13 +112,14 @@ class CEvaluator:
         inputs: Sequence[np.ndarray],
         outputs: Sequence[np.ndarray],
     ) -> None:
-        for out in outputs:
+        public = [o for o, info in zip(outputs, function.outputs, strict=True) if not info.hidden]
+        for out in public:
             if not out.flags.c_contiguous:
                 raise InputError("outputs of the c backend must be C-contiguous (n, size) arrays")
         batch = self.library.entries[function.name].batch
         n = inputs[0].shape[0]
         batch(params.ctypes.data, n, *(a.ctypes.data for a in inputs),
-              *(o.ctypes.data for o in outputs))  # fmt: skip
+              *(o.ctypes.data for o in public))  # fmt: skip
 
 
 _EVALUATORS: dict[tuple[str, str], Evaluator] = {}

@@ -32,6 +32,7 @@ class ArgInfo:
     units: tuple[str, ...]
     doc: str
     table: str | None = None
+    hidden: bool = False  # an output the failure checks read, not part of the C interface
 
     @property
     def size(self) -> int:
@@ -59,8 +60,13 @@ class FunctionInfo:
     numpy_function: str
     doc: str
     inputs: tuple[ArgInfo, ...]
-    outputs: tuple[ArgInfo, ...]
+    outputs: tuple[ArgInfo, ...]  # the public ones first, then any hidden one
     checks: tuple[CheckInfo, ...]
+
+    @property
+    def public_outputs(self) -> tuple[ArgInfo, ...]:
+        """The outputs of the C interface and of the Python API."""
+        return tuple(o for o in self.outputs if not o.hidden)
 
 
 @dataclass(frozen=True)
@@ -111,6 +117,7 @@ def _arg(data: dict) -> ArgInfo:
         units=tuple(c["unit"] for c in comps),
         doc=data["doc"],
         table=data.get("table"),
+        hidden=bool(data.get("hidden", False)),
     )
 
 

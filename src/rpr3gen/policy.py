@@ -35,14 +35,20 @@ DEFAULT_MIN_CONDITIONING = 1e-3
 
 
 def return_codes(
-    function: FunctionInfo, inputs: Sequence[np.ndarray], outputs: Sequence[np.ndarray]
+    function: FunctionInfo,
+    inputs: Sequence[np.ndarray],
+    outputs: Sequence[np.ndarray],
+    applied: bool = False,
 ) -> np.ndarray:
     """Per sample, the code the generated C returns for it: 0, or the first failed check's.
 
     Args:
         function: the function, from the manifest.
         inputs: its inputs, each (n, size).
-        outputs: its outputs as computed, each (n, size) (any backend; NaN rows allowed).
+        outputs: all its outputs as computed, hidden ones included, each (n, size).
+        applied: the backend applied the checks itself and wrote a failed sample as a row of
+            NaN (the generated C batch): then a failed sample's code is the input check's when
+            an input is not finite, else the one code all the other checks share.
 
     Returns:
         (n,) int array.
@@ -50,6 +56,20 @@ def return_codes(
     n = inputs[0].shape[0]
     codes = np.zeros(n, dtype=np.intc)
     pending = np.ones(n, dtype=bool)
+    if applied:
+        public = [o for o, info in zip(outputs, function.outputs, strict=True) if not info.hidden]
+        failed = np.zeros(n, dtype=bool)
+        for out in public:
+            failed |= np.isnan(out).all(axis=1)
+        for check in function.checks:
+            if check.kind == "inputs_not_finite":
+                bad = ~np.all([np.isfinite(a).all(axis=1) for a in inputs], axis=0)
+                codes[bad] = check.code
+                pending &= ~bad
+        later = [c.code for c in function.checks if c.kind != "inputs_not_finite"]
+        if later:
+            codes[failed & pending] = later[0]
+        return codes
     with np.errstate(invalid="ignore"):
         for check in function.checks:
             if check.kind == "inputs_not_finite":
@@ -60,7 +80,8 @@ def return_codes(
                 value = outputs[check.output][:, check.component]
                 failed = ~(value >= check.threshold)
             else:
-                failed = ~np.all([np.isfinite(a).all(axis=1) for a in outputs], axis=0)
+                public = [o for o, i in zip(outputs, function.outputs, strict=True) if not i.hidden]
+                failed = ~np.all([np.isfinite(a).all(axis=1) for a in public], axis=0)
             hit = failed & pending
             codes[hit] = check.code
             pending &= ~hit
@@ -68,10 +89,16 @@ def return_codes(
 
 
 def apply(
-    function: FunctionInfo, inputs: Sequence[np.ndarray], outputs: Sequence[np.ndarray]
+    function: FunctionInfo,
+    inputs: Sequence[np.ndarray],
+    outputs: Sequence[np.ndarray],
+    applied: bool = False,
 ) -> np.ndarray:
-    """Blank (NaN) every output row of a failed sample, in place; return the codes."""
-    codes = return_codes(function, inputs, outputs)
+    """Blank (NaN) every output row of a failed sample, in place; return the codes.
+
+    ``applied``: as in :func:`return_codes`.
+    """
+    codes = return_codes(function, inputs, outputs, applied)
     failed = codes != 0
     if failed.any():
         for out in outputs:

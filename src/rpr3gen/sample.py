@@ -43,7 +43,7 @@ class SampleEvaluator:
         self.codes = dict(variant.code_meanings)
         self.params = np.ascontiguousarray(model.vector(variant.param_names))
         self.inputs = {a.name: np.zeros(a.size) for a in self.function.inputs}
-        self.outputs = {o.name: np.full(o.size, np.nan) for o in self.function.outputs}
+        self.outputs = {o.name: np.full(o.size, np.nan) for o in self.function.public_outputs}
         for name, buffer in (*self.inputs.items(), *self.outputs.items()):
             setattr(self, name, buffer)
         first = self.function.outputs[0]
@@ -66,8 +66,8 @@ class SampleEvaluator:
         self._evaluator.run(self.function, self.params, inputs, self._scratch)
         code = int(policy.return_codes(self.function, inputs, self._scratch)[0])
         if code == 0:
-            for out, scratch in zip(self.outputs.values(), self._scratch, strict=True):
-                out[:] = scratch[0]
+            for out, scratch in zip(self.outputs.values(), self._scratch, strict=False):
+                out[:] = scratch[0]  # the public outputs come first
         return code
 
     def evaluate(self, *inputs: ArrayLike) -> np.ndarray:

@@ -68,10 +68,10 @@ def _function(module: ModuleSpec, c: Compiled) -> dict[str, Any]:
     name = f"{prefix}_{spec.name}"
     single = ["const double *params"]
     single += [f"const double {a.name}[{a.size}]" for a in spec.inputs]
-    single += [f"double {o.name}[{sizes[o.name]}]" for o in spec.outputs]
+    single += [f"double {o.name}[{sizes[o.name]}]" for o in spec.public_outputs]
     batch = ["const double *params", "size_t n"]
     batch += [f"const double *{a.name}" for a in spec.inputs]
-    batch += [f"double *{o.name}" for o in spec.outputs]
+    batch += [f"double *{o.name}" for o in spec.public_outputs]
     kernel = ["const double *restrict params"]
     kernel += [f"const double *restrict {a.name}" for a in spec.inputs]
     kernel += [f"double *restrict r_{o.name}" for o in spec.outputs]
