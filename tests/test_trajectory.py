@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rpr3gen.errors import Rpr3genError, TrajectoryError
+from rpr3gen.errors import InputTypeError, Rpr3genError, TrajectoryError
 from rpr3gen.trajectory import (
     CSV_COLUMNS,
     PAPER_TRAJECTORIES,
@@ -79,15 +79,27 @@ def test_samples_and_duration_are_used() -> None:
     assert len(paper_trajectory("rotation", samples=np.int64(3), duration=1)) == 3
 
 
-@pytest.mark.parametrize("samples", [1, 0, -5, 2.5, True, "10", None])
+@pytest.mark.parametrize("samples", [1, 0, -5])
 def test_bad_samples(samples: object) -> None:
     with pytest.raises(TrajectoryError, match="samples"):
         paper_trajectory("rotation", samples=samples)  # type: ignore[arg-type]
 
 
-@pytest.mark.parametrize("duration", [0.0, -1.0, math.nan, math.inf, True, "3", None])
+@pytest.mark.parametrize("samples", [2.5, True, "10", None])
+def test_samples_of_the_wrong_type(samples: object) -> None:
+    with pytest.raises(InputTypeError, match="samples"):
+        paper_trajectory("rotation", samples=samples)  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize("duration", [0.0, -1.0, math.nan, math.inf])
 def test_bad_duration(duration: object) -> None:
     with pytest.raises(TrajectoryError, match="duration"):
+        paper_trajectory("rotation", duration=duration)  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize("duration", [True, "3", None])
+def test_duration_of_the_wrong_type(duration: object) -> None:
+    with pytest.raises(InputTypeError, match="duration"):
         paper_trajectory("rotation", duration=duration)  # type: ignore[arg-type]
 
 

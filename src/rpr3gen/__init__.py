@@ -12,7 +12,7 @@ The runtime imports numpy (and matplotlib for figures) only; regeneration lives 
 """
 
 from rpr3gen.backends import BACKENDS, OUTPUT_NAMES, inverse_dynamics
-from rpr3gen.errors import ModelError, Rpr3genError, TrajectoryError
+from rpr3gen.errors import InputError, InputTypeError, ModelError, Rpr3genError, TrajectoryError
 from rpr3gen.model import PARAM_NAMES, Model, load_model
 from rpr3gen.sample import SampleEvaluator
 from rpr3gen.trajectory import Trajectory, paper_trajectory, read_trajectory_csv
@@ -21,6 +21,8 @@ __all__ = [
     "BACKENDS",
     "OUTPUT_NAMES",
     "PARAM_NAMES",
+    "InputError",
+    "InputTypeError",
     "Model",
     "ModelError",
     "Rpr3genError",

@@ -16,6 +16,8 @@ from typing import IO, Any
 
 import numpy as np
 
+from rpr3gen.errors import InputError
+
 __all__ = ["atomic_write", "write_csv_table", "write_results_csv"]
 
 _WRITE_MODES = frozenset({"w", "wt", "wb", "tw", "bw"})
@@ -38,11 +40,11 @@ def atomic_write(path: str | os.PathLike[str], mode: str = "w", **kw: Any) -> It
         The open temporary file.
 
     Raises:
-        ValueError: For a mode other than a plain write mode.
+        InputError: For a mode other than a plain write mode.
         OSError: If the temporary file cannot be created, written or renamed.
     """
     if mode not in _WRITE_MODES:
-        raise ValueError(f"atomic_write: mode must be 'w' or 'wb', got {mode!r}")
+        raise InputError(f"atomic_write: mode must be 'w' or 'wb', got {mode!r}")
     if "b" not in mode:
         kw.setdefault("encoding", "utf-8")
     target = os.path.abspath(os.fspath(path))
@@ -89,25 +91,25 @@ def write_results_csv(
         names: Which outputs to write, in column order.
 
     Raises:
-        ValueError: If a shape is wrong, or a name is missing from ``outputs`` or repeated.
+        InputError: If a shape is wrong, or a name is missing from ``outputs`` or repeated.
         OSError: If the file cannot be written.
     """
     t = np.asarray(t, dtype=np.float64)
     q = np.asarray(q, dtype=np.float64)
     if t.ndim != 1:
-        raise ValueError(f"t must have shape (n,), got {t.shape}")
+        raise InputError(f"t must have shape (n,), got {t.shape}")
     n = t.size
     if q.shape != (n, 3):
-        raise ValueError(f"q must have shape ({n}, 3), got {q.shape}")
+        raise InputError(f"q must have shape ({n}, 3), got {q.shape}")
     if len(set(names)) != len(names):
-        raise ValueError("names must not repeat")
+        raise InputError("names must not repeat")
     columns = [t, q[:, 0], q[:, 1], q[:, 2]]
     for name in names:
         if name not in outputs:
-            raise ValueError(f"no output named {name!r}")
+            raise InputError(f"no output named {name!r}")
         value = np.asarray(outputs[name], dtype=np.float64)
         if value.shape not in ((n,), ()):
-            raise ValueError(f"output {name!r} must have shape ({n},), got {value.shape}")
+            raise InputError(f"output {name!r} must have shape ({n},), got {value.shape}")
         columns.append(np.broadcast_to(value, (n,)))
     write_csv_table(path, ["t", "x", "y", "phi", *names], np.column_stack(columns))
 
@@ -121,12 +123,12 @@ def write_csv_table(path: str | os.PathLike[str], header: Sequence[str], table: 
         table: Values, shape ``(n, len(header))``.
 
     Raises:
-        ValueError: If the table's shape does not match the header.
+        InputError: If the table's shape does not match the header.
         OSError: If the file cannot be written.
     """
     table = np.asarray(table, dtype=np.float64)
     if table.ndim != 2 or table.shape[1] != len(header):
-        raise ValueError(f"table must have shape (n, {len(header)}), got {table.shape}")
+        raise InputError(f"table must have shape (n, {len(header)}), got {table.shape}")
     with atomic_write(path, "w", newline="") as f:
         f.write(",".join(header) + "\n")
         for row in table:

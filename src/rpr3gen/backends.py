@@ -16,7 +16,7 @@ import numpy as np
 import rpr3gen_generated as generated
 from numpy.typing import ArrayLike
 
-from rpr3gen.errors import Rpr3genError
+from rpr3gen.errors import InputError, Rpr3genError
 from rpr3gen.model import Model
 
 BACKENDS: tuple[str, ...] = ("numpy", "c")
@@ -46,7 +46,7 @@ def _samples(name: str, value: ArrayLike) -> np.ndarray:
     if array.ndim == 1 and array.shape == (3,):
         array = array[np.newaxis, :]
     if array.ndim != 2 or array.shape[1] != 3:
-        raise Rpr3genError(f"{name} must have shape (n, 3), got {np.shape(value)}")
+        raise InputError(f"{name} must have shape (n, 3), got {np.shape(value)}")
     return np.ascontiguousarray(array)
 
 
@@ -111,7 +111,7 @@ def _evaluate(
                 params, q[block], qd[block], qdd[block], model.actuation, out=rows[block]
             )
         return rows.T
-    raise Rpr3genError(f"unknown backend {backend!r}; choose one of {', '.join(BACKENDS)}")
+    raise InputError(f"unknown backend {backend!r}; choose one of {', '.join(BACKENDS)}")
 
 
 def inverse_dynamics(
@@ -143,7 +143,7 @@ def inverse_dynamics(
     """
     q, qd, qdd = _samples("q", q), _samples("qd", qd), _samples("qdd", qdd)
     if not q.shape == qd.shape == qdd.shape:
-        raise Rpr3genError(f"q, qd, qdd differ in shape: {q.shape}, {qd.shape}, {qdd.shape}")
+        raise InputError(f"q, qd, qdd differ in shape: {q.shape}, {qd.shape}, {qdd.shape}")
     out = _evaluate(model, q, qd, qdd, backend, progress)
     with np.errstate(invalid="ignore"):
         singular = ~(out[-1] >= SINGULAR_CONDITIONING) | ~np.isfinite(out).all(axis=0)

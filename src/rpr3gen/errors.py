@@ -1,22 +1,46 @@
-"""Exceptions raised for bad user input (model files, trajectories).
+"""Exceptions and warnings raised for bad user input (model files, trajectories, arrays).
 
-Each carries a one-line, user-facing message that already names the file, the key or the
+Each error carries a one-line, user-facing message that already names the file, the key or the
 row and column at fault; the command line prints it as ``rpr3gen: error: <msg>`` and exits
 with status 2, without a traceback.
+
+Every error of the package derives from :class:`Rpr3genError`. Those about a bad value also
+derive from :class:`ValueError`, and those about a value of the wrong type from
+:class:`TypeError`, so code written against the standard exceptions catches them too::
+
+    Rpr3genError(Exception)
+    ├── ModelError(Rpr3genError, ValueError)        a model file or dictionary
+    ├── TrajectoryError(Rpr3genError, ValueError)   a trajectory file or request
+    ├── InputError(Rpr3genError, ValueError)        an array or argument of the Python API
+    └── InputTypeError(Rpr3genError, TypeError)     an argument of the wrong type
 """
 
 from __future__ import annotations
 
-__all__ = ["ModelError", "Rpr3genError", "TrajectoryError"]
+__all__ = [
+    "InputError",
+    "InputTypeError",
+    "ModelError",
+    "Rpr3genError",
+    "TrajectoryError",
+]
 
 
 class Rpr3genError(Exception):
-    """Base class of every error caused by user input; ``str(err)`` is one line."""
+    """Base class of every error the package raises on purpose; ``str(err)`` is one line."""
 
 
-class ModelError(Rpr3genError):
+class ModelError(Rpr3genError, ValueError):
     """A model file (or dictionary) is missing, malformed or describes a degenerate robot."""
 
 
-class TrajectoryError(Rpr3genError):
+class TrajectoryError(Rpr3genError, ValueError):
     """A trajectory file or a trajectory request is malformed."""
+
+
+class InputError(Rpr3genError, ValueError):
+    """An array or argument given to the Python API has a bad shape or value."""
+
+
+class InputTypeError(Rpr3genError, TypeError):
+    """An argument given to the Python API has the wrong type."""

@@ -17,6 +17,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from rpr3gen.atomic import atomic_write
+from rpr3gen.errors import InputError
 from rpr3gen.model import ACTUATIONS, LEGS
 
 __all__ = ["DPI", "FIGSIZE", "FamilyPlot", "plot_families", "plotted_families"]
@@ -86,10 +87,10 @@ def plotted_families(actuation: str) -> tuple[FamilyPlot, ...]:
     """The families :func:`plot_families` draws for a robot with the given actuation, in order.
 
     Raises:
-        ValueError: If ``actuation`` is not ``"revolute"`` or ``"prismatic"``.
+        InputError: If ``actuation`` is not ``"revolute"`` or ``"prismatic"``.
     """
     if actuation not in ACTUATIONS:
-        raise ValueError(f"actuation must be one of {ACTUATIONS}, got {actuation!r}")
+        raise InputError(f"actuation must be one of {ACTUATIONS}, got {actuation!r}")
     return (*_PAPER_FAMILIES, _ACTUATOR[actuation], *_LEG_VARIABLES)
 
 
@@ -120,22 +121,22 @@ def plot_families(
         The paths written, in the order of :func:`plotted_families`.
 
     Raises:
-        ValueError: If ``actuation`` is unknown, an output is missing or a shape is wrong.
+        InputError: If ``actuation`` is unknown, an output is missing or a shape is wrong.
         OSError: If a folder or file cannot be written.
     """
     t = np.asarray(t, dtype=np.float64)
     if t.ndim != 1:
-        raise ValueError(f"t must have shape (n,), got {t.shape}")
+        raise InputError(f"t must have shape (n,), got {t.shape}")
     families = plotted_families(actuation)
     curves: dict[str, np.ndarray] = {}
     for spec in families:
         for leg in LEGS:
             key = f"{spec.family}_{leg}"
             if key not in outputs:
-                raise ValueError(f"no output named {key!r} to plot")
+                raise InputError(f"no output named {key!r} to plot")
             y = np.asarray(outputs[key], dtype=np.float64)
             if y.shape not in (t.shape, ()):
-                raise ValueError(f"output {key!r} must have shape {t.shape}, got {y.shape}")
+                raise InputError(f"output {key!r} must have shape {t.shape}, got {y.shape}")
             curves[key] = np.broadcast_to(y, t.shape)
 
     folder = Path(outdir)

@@ -21,7 +21,7 @@ from typing import TextIO
 import numpy as np
 
 from rpr3gen.atomic import write_csv_table
-from rpr3gen.errors import TrajectoryError
+from rpr3gen.errors import InputTypeError, TrajectoryError
 
 __all__ = [
     "CSV_COLUMNS",
@@ -90,21 +90,24 @@ def paper_trajectory(name: str, samples: int = 301, duration: float = 3.0) -> Tr
         duration: Length of the motion, s, finite and positive (the paper: 3 s).
 
     Raises:
-        TrajectoryError: For an unknown name or a bad ``samples`` or ``duration``.
+        TrajectoryError: For an unknown name, ``samples < 2`` or a ``duration`` not finite and
+            positive.
+        InputTypeError: If ``samples`` is not an integer or ``duration`` not a number.
     """
     if name not in PAPER_TRAJECTORIES:
         match = difflib.get_close_matches(str(name), list(PAPER_TRAJECTORIES), n=1)
         hint = f"; did you mean '{match[0]}'?" if match else ""
         choices = " or ".join(PAPER_TRAJECTORIES)
         raise TrajectoryError(f"unknown trajectory {name!r}: choose {choices}{hint}")
-    if isinstance(samples, bool) or not isinstance(samples, int | np.integer) or samples < 2:
+    if isinstance(samples, bool) or not isinstance(samples, int | np.integer):
+        raise InputTypeError(f"samples: must be an integer >= 2, got {samples!r}")
+    if samples < 2:
         raise TrajectoryError(f"samples: must be an integer >= 2, got {samples!r}")
-    if (
-        isinstance(duration, bool)
-        or not isinstance(duration, int | float | np.integer | np.floating)
-        or not math.isfinite(duration)
-        or duration <= 0
+    if isinstance(duration, bool) or not isinstance(
+        duration, int | float | np.integer | np.floating
     ):
+        raise InputTypeError(f"duration: must be a finite number of seconds > 0, got {duration!r}")
+    if not math.isfinite(duration) or duration <= 0:
         raise TrajectoryError(f"duration: must be a finite number of seconds > 0, got {duration!r}")
 
     amplitude = np.array(PAPER_TRAJECTORIES[name], dtype=np.float64)
