@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import csv
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -125,3 +126,22 @@ def test_singular_pose_is_refused_with_its_time(tmp_path: Path) -> None:
     assert result.returncode == 2
     assert "t = 1 s" in result.stderr
     assert not out.exists()
+
+
+@pytest.mark.parametrize("command", ["simulate", "params", "paper"])
+def test_a_reader_that_went_away_ends_the_command_quietly(command: str, tmp_path: Path) -> None:
+    # As `rpr3gen simulate | head -0`: the pipe's reader is gone before the first line.
+    read_end, write_end = os.pipe()
+    os.close(read_end)
+    args = [command, "--out", str(tmp_path / "paper")] if command == "paper" else [command]
+    try:
+        result = subprocess.run(
+            [sys.executable, "-m", "rpr3gen.cli", *args],
+            stdout=write_end, stderr=subprocess.PIPE, text=True, check=False, cwd=tmp_path,
+        )  # fmt: skip
+    finally:
+        os.close(write_end)
+    assert result.stderr == ""
+    assert result.returncode == 0
+    if command == "paper":  # the files were complete before the summary was printed
+        assert (tmp_path / "paper" / "rectilinear.csv").is_file()

@@ -7,6 +7,8 @@ shows the traceback instead. Output files are written atomically.
 from __future__ import annotations
 
 import argparse
+import contextlib
+import os
 import sys
 from collections.abc import Sequence
 from pathlib import Path
@@ -185,12 +187,14 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
 def _cmd_paper(args: argparse.Namespace) -> int:
     model = load_model()
     root = Path(args.out)
+    summaries = []  # printed once every file is written, so a closed stdout stops nothing
     for name in PAPER_TRAJECTORIES:
         traj = paper_trajectory(name)
         out = simulate(
             model, name, traj, args.backend, str(root / f"{name}.csv"), str(root / "figures")
         )
-        print(_summary(name, model, traj, out))
+        summaries.append(_summary(name, model, traj, out))
+    print("\n".join(summaries))
     print(f"wrote {root / '*.csv'} and {root / 'figures'}/*.png")
     return 0
 
@@ -241,7 +245,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         "generate": _cmd_generate,
     }
     try:
-        return commands[args.command](args)
+        status = commands[args.command](args)
+        sys.stdout.flush()  # a reader that went away shows here, not at the interpreter's exit
+        return status
+    except BrokenPipeError:
+        return _reader_went_away()
     except (Rpr3genError, OSError) as exc:
         if args.debug:
             raise
@@ -251,6 +259,21 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("rpr3gen: interrupted", file=sys.stderr)
         return 130
+
+
+def _reader_went_away() -> int:
+    """``rpr3gen ... | head -1``: the reader of stdout closed the pipe; stop quietly, status 0.
+
+    Every output file is complete by then (stdout gets only the summary, printed last); what
+    is lost is the text that the reader chose not to read.
+    """
+    # Python flushes stdout once more at exit and would report the pipe again: send the rest
+    # of the buffer to /dev/null instead.
+    with contextlib.suppress(OSError, ValueError):
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        os.close(devnull)
+    return 0
 
 
 def _os_message(exc: OSError) -> str:
