@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import csv
+import importlib.metadata
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -145,3 +147,78 @@ def test_a_reader_that_went_away_ends_the_command_quietly(command: str, tmp_path
     assert result.returncode == 0
     if command == "paper":  # the files were complete before the summary was printed
         assert (tmp_path / "paper" / "rectilinear.csv").is_file()
+
+
+# -- options are checked, not ignored ----------------------------------------------------------
+
+
+@pytest.mark.parametrize("value", ["2", "1", "-0.1", "nan", "x"])
+def test_min_conditioning_is_range_checked_before_any_work(value: str, tmp_path: Path) -> None:
+    result = _cli("simulate", "--min-conditioning", value, "--out", "o.csv", cwd=tmp_path)
+    assert result.returncode == 2
+    assert result.stderr.count("\n") == 1, result.stderr
+    assert "--min-conditioning" in result.stderr
+    assert "t = " not in result.stderr
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_min_conditioning_zero_is_allowed(tmp_path: Path) -> None:
+    assert main(["simulate", "--min-conditioning", "0", "--out", str(tmp_path / "o.csv")]) == 0
+
+
+@pytest.mark.parametrize("option", [["--samples", "11"], ["--duration", "2"]])
+def test_paper_trajectory_options_with_a_csv_file_are_an_error(
+    option: list[str], tmp_path: Path
+) -> None:
+    motion = tmp_path / "motion.csv"
+    write_trajectory_csv(motion, rpr3gen.paper_trajectory("rectilinear", samples=11))
+    result = _cli("simulate", "--trajectory", str(motion), *option, cwd=tmp_path)
+    assert result.returncode == 2
+    assert result.stderr.count("\n") == 1, result.stderr
+    assert option[0] in result.stderr
+    assert "motion.csv" in result.stderr
+
+
+def test_samples_and_duration_apply_to_a_paper_trajectory(capsys: pytest.CaptureFixture) -> None:
+    assert main(["simulate", "--samples", "11", "--duration", "2"]) == 0
+    assert "rotation: 11 samples over 2 s" in capsys.readouterr().out
+
+
+def test_a_mistyped_trajectory_name_gets_a_suggestion(tmp_path: Path) -> None:
+    result = _cli("simulate", "--trajectory", "rotaton", cwd=tmp_path)
+    assert result.returncode == 2
+    assert "did you mean 'rotation'?" in result.stderr
+
+
+def test_help_gives_every_default_and_the_units(capsys: pytest.CaptureFixture) -> None:
+    for command in ("simulate", "paper", "params", "generate"):
+        with pytest.raises(SystemExit) as info:
+            main([command, "--help"])
+        assert info.value.code == 0
+        text = " ".join(capsys.readouterr().out.split())
+        options = re.split(r" (?=--[a-z])", text.split("options: ", 1)[1])[1:]
+        assert len(options) > 1, text
+        for option in options[1:]:  # after --help, each option's help ends with its default
+            assert "(default: " in option, (command, option)
+    with pytest.raises(SystemExit):
+        main(["simulate", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert "duration of a paper trajectory, s (default: 3)" in text
+    assert "(dimensionless, 0 = singular, 1 = best)" in text
+    assert "(default: 0.001)" in text
+
+
+def test_bare_command_prints_the_usage(tmp_path: Path) -> None:
+    result = _cli(cwd=tmp_path)
+    assert result.returncode == 2
+    assert result.stderr.startswith("usage: rpr3gen")
+    for command in ("simulate", "paper", "params", "generate"):
+        assert command in result.stderr
+
+
+def test_version(capsys: pytest.CaptureFixture) -> None:
+    with pytest.raises(SystemExit) as info:
+        main(["--version"])
+    assert info.value.code == 0
+    assert capsys.readouterr().out == f"rpr3gen {rpr3gen.__version__}\n"
+    assert rpr3gen.__version__ == importlib.metadata.version("rpr3gen")

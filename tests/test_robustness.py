@@ -199,7 +199,7 @@ def test_bad_model_files(edit, expected: str, tmp_path: Path, repo_root: Path) -
 
 
 def test_usage_errors_are_one_line() -> None:
-    for argv in (["simulate", "--samples", "many"], ["frobnicate"], []):
+    for argv in (["simulate", "--samples", "many"], ["frobnicate"]):
         result = subprocess.run(
             [sys.executable, "-m", "rpr3gen.cli", *argv], capture_output=True, text=True
         )

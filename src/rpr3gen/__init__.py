@@ -11,11 +11,18 @@ The runtime imports numpy (and matplotlib for figures) only; regeneration lives 
 ``rpr3gen_derive`` (folder ``derive/``) and writes ``rpr3gen_generated`` (folder ``generated/``).
 """
 
+import importlib.metadata
+
 from rpr3gen.backends import BACKENDS, OUTPUT_NAMES, inverse_dynamics
 from rpr3gen.errors import InputError, InputTypeError, ModelError, Rpr3genError, TrajectoryError
 from rpr3gen.model import PARAM_NAMES, Model, load_model
 from rpr3gen.sample import SampleEvaluator
 from rpr3gen.trajectory import Trajectory, paper_trajectory, read_trajectory_csv
+
+try:
+    __version__ = importlib.metadata.version("rpr3gen")
+except importlib.metadata.PackageNotFoundError:  # the source tree on sys.path, not installed
+    __version__ = "0+unknown"
 
 __all__ = [
     "BACKENDS",
@@ -29,6 +36,7 @@ __all__ = [
     "SampleEvaluator",
     "Trajectory",
     "TrajectoryError",
+    "__version__",
     "inverse_dynamics",
     "load_model",
     "paper_trajectory",

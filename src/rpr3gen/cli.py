@@ -16,10 +16,18 @@ from typing import NoReturn
 
 import numpy as np
 
+from rpr3gen import __version__
 from rpr3gen.backends import BACKENDS, OUTPUT_NAMES, inverse_dynamics
-from rpr3gen.errors import Rpr3genError
+from rpr3gen.errors import InputError, Rpr3genError, TrajectoryError, did_you_mean
 from rpr3gen.model import Model, load_model
-from rpr3gen.trajectory import PAPER_TRAJECTORIES, Trajectory, paper_trajectory, read_trajectory_csv
+from rpr3gen.trajectory import (
+    DEFAULT_DURATION,
+    DEFAULT_SAMPLES,
+    PAPER_TRAJECTORIES,
+    Trajectory,
+    paper_trajectory,
+    read_trajectory_csv,
+)
 from rpr3gen.validity import DEFAULT_MIN_CONDITIONING, invalid_samples
 
 EXIT_ERROR = 2
@@ -32,70 +40,135 @@ class _Parser(argparse.ArgumentParser):
         self.exit(EXIT_ERROR, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
 
 
+def _conditioning_threshold(text: str) -> float:
+    """Type of ``--min-conditioning``: a number in [0, 1) (conditioning is 1 at best)."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
+    if not 0.0 <= value < 1.0:
+        raise argparse.ArgumentTypeError(
+            f"must be in [0, 1), got {text}: conditioning is at most 1, so a threshold of 1 "
+            "or more refuses every pose"
+        )
+    return value
+
+
 def _parser() -> argparse.ArgumentParser:
     parser = _Parser(
         prog="rpr3gen",
         description="Inverse dynamics of the 3-RPR planar parallel robot (Staicu), "
-        "from generated code.",
+        "from generated code. SI units throughout (m, rad, s, N, N·m).",
+        epilog="Run 'rpr3gen COMMAND --help' for the options of a command.",
     )
+    parser.add_argument("--version", action="version", version=f"rpr3gen {__version__}")
     parser.add_argument("--debug", action="store_true", help="show tracebacks on errors")
-    sub = parser.add_subparsers(
-        dest="command", required=True, metavar="COMMAND", parser_class=_Parser
-    )
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+    paper_model = "default: the paper's robot, models/paper.toml"
 
     sim = sub.add_parser("simulate", help="evaluate the inverse dynamics over a trajectory")
-    sim.add_argument("--model", metavar="FILE", help="model TOML file (default: the paper's)")
+    sim.add_argument("--model", metavar="FILE", help=f"model TOML file ({paper_model})")
     sim.add_argument(
         "--trajectory",
         default="rotation",
         metavar="NAME|FILE.csv",
-        help="'rotation' or 'rectilinear' (paper eq. 3) or a trajectory CSV (default: rotation)",
+        help="'rotation' or 'rectilinear' (the paper's motions, eq. 3), or a trajectory CSV "
+        "file (default: rotation)",
     )
-    sim.add_argument("--samples", type=int, default=301, help="samples of a paper trajectory")
-    sim.add_argument("--duration", type=float, default=3.0, help="duration of a paper trajectory")
-    sim.add_argument("--backend", choices=BACKENDS, default="numpy")
-    sim.add_argument("--out", metavar="FILE.csv", help="write every output as CSV")
-    sim.add_argument("--plots", metavar="DIR", help="write the paper's figures as PNG")
+    sim.add_argument(
+        "--samples",
+        type=int,
+        metavar="N",
+        help="number of samples of a paper trajectory, both ends included "
+        f"(default: {DEFAULT_SAMPLES})",
+    )
+    sim.add_argument(
+        "--duration",
+        type=float,
+        metavar="T",
+        help=f"duration of a paper trajectory, s (default: {DEFAULT_DURATION:g})",
+    )
+    sim.add_argument(
+        "--backend",
+        choices=BACKENDS,
+        default="numpy",
+        help="evaluate the generated NumPy or C code (default: numpy)",
+    )
+    sim.add_argument(
+        "--out",
+        metavar="FILE.csv",
+        help="write t,x,y,phi and every output as CSV, SI units (default: no file)",
+    )
+    sim.add_argument(
+        "--plots",
+        metavar="DIR",
+        help="write the paper's figures into DIR as PNG (default: no figures)",
+    )
     sim.add_argument(
         "--min-conditioning",
-        type=float,
+        type=_conditioning_threshold,
         default=DEFAULT_MIN_CONDITIONING,
         metavar="C",
-        help="refuse poses whose output 'conditioning' (0 = singular, 1 = best) is below C "
-        f"(default {DEFAULT_MIN_CONDITIONING:g})",
+        help="refuse poses whose output 'conditioning' (dimensionless, 0 = singular, 1 = best) "
+        f"is below C, 0 <= C < 1 (default: {DEFAULT_MIN_CONDITIONING:g})",
     )
     sim.add_argument(
         "--allow-invalid",
         action="store_true",
         help="write rows at poses too close to a singularity or outside a stroke limit as NaN "
-        "instead of refusing the trajectory",
+        "instead of refusing the trajectory (default: refuse)",
     )
 
     paper = sub.add_parser("paper", help="run the paper's two examples: CSV and figures")
-    paper.add_argument("--out", default="results", metavar="DIR", help="default: ./results")
-    paper.add_argument("--backend", choices=BACKENDS, default="numpy")
+    paper.add_argument(
+        "--out", default="results", metavar="DIR", help="output folder (default: ./results)"
+    )
+    paper.add_argument(
+        "--backend",
+        choices=BACKENDS,
+        default="numpy",
+        help="evaluate the generated NumPy or C code (default: numpy)",
+    )
 
     par = sub.add_parser(
         "params", help="print a model's parameter vector as 'name value' lines (for C users)"
     )
-    par.add_argument("--model", metavar="FILE", help="model TOML file (default: the paper's)")
+    par.add_argument("--model", metavar="FILE", help=f"model TOML file ({paper_model})")
 
     gen = sub.add_parser("generate", help="derive and write the generated sources")
-    gen.add_argument("--model", metavar="FILE", help="generate only this model's actuation")
-    gen.add_argument("--out", metavar="DIR", help="default: the source tree's generated/")
     gen.add_argument(
-        "--check", action="store_true", help="write nothing; fail if the sources are stale"
+        "--model",
+        metavar="FILE",
+        help="generate only this model's actuation (default: both actuations)",
+    )
+    gen.add_argument(
+        "--out", metavar="DIR", help="output folder (default: the source tree's generated/)"
+    )
+    gen.add_argument(
+        "--check",
+        action="store_true",
+        help="write nothing; fail if the sources are stale (default: write them)",
     )
     return parser
 
 
 def _trajectory(args: argparse.Namespace) -> tuple[str, Trajectory]:
+    timing = {"samples": args.samples, "duration": args.duration}
+    given = [f"--{key}" for key, value in timing.items() if value is not None]
     if args.trajectory in PAPER_TRAJECTORIES:
-        return args.trajectory, paper_trajectory(args.trajectory, args.samples, args.duration)
+        kwargs = {key: value for key, value in timing.items() if value is not None}
+        return args.trajectory, paper_trajectory(args.trajectory, **kwargs)
     path = Path(args.trajectory)
     if path.suffix.lower() != ".csv" and not path.exists():
         names = ", ".join(PAPER_TRAJECTORIES)
-        raise Rpr3genError(f"--trajectory: {args.trajectory!r} is neither {names} nor a CSV file")
+        hint = did_you_mean(args.trajectory, PAPER_TRAJECTORIES)
+        raise TrajectoryError(
+            f"--trajectory: {args.trajectory!r} is neither {names} nor a CSV file{hint}"
+        )
+    if given:
+        raise TrajectoryError(
+            f"{' and '.join(given)}: only for the paper trajectories; {path} has its own times"
+        )
     return path.stem, read_trajectory_csv(path)
 
 
@@ -137,8 +210,8 @@ def simulate(
     """
     from rpr3gen.atomic import write_results_csv
 
-    if not min_conditioning >= 0.0:
-        raise Rpr3genError(f"--min-conditioning must be >= 0, got {min_conditioning}")
+    if not 0.0 <= min_conditioning < 1.0:
+        raise InputError(f"min_conditioning: must be in [0, 1), got {min_conditioning!r}")
     out = inverse_dynamics(model, traj.q, traj.qd, traj.qdd, backend=backend, progress=True)
     _screen(model, traj, out, min_conditioning, allow_invalid)
     if out_csv:
@@ -237,7 +310,11 @@ def _cmd_generate(args: argparse.Namespace) -> int:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``rpr3gen`` command; returns the exit status."""
-    args = _parser().parse_args(argv)
+    parser = _parser()
+    args = parser.parse_args(argv)
+    if args.command is None:  # a bare `rpr3gen`: show what it can do
+        parser.print_help(sys.stderr)
+        return EXIT_ERROR
     commands = {
         "simulate": _cmd_simulate,
         "paper": _cmd_paper,

@@ -17,12 +17,16 @@ derive from :class:`ValueError`, and those about a value of the wrong type from
 
 from __future__ import annotations
 
+import difflib
+from collections.abc import Iterable
+
 __all__ = [
     "InputError",
     "InputTypeError",
     "ModelError",
     "Rpr3genError",
     "TrajectoryError",
+    "did_you_mean",
 ]
 
 
@@ -44,3 +48,9 @@ class InputError(Rpr3genError, ValueError):
 
 class InputTypeError(Rpr3genError, TypeError):
     """An argument given to the Python API has the wrong type."""
+
+
+def did_you_mean(word: str, choices: Iterable[str]) -> str:
+    """``"; did you mean 'x'?"`` for the choice closest to ``word``, ``""`` if none is close."""
+    match = difflib.get_close_matches(word, list(choices), n=1, cutoff=0.6)
+    return f"; did you mean '{match[0]}'?" if match else ""

@@ -12,7 +12,6 @@ names the file and the dotted key, e.g. ``my.toml: geometry.l0: must be a positi
 
 from __future__ import annotations
 
-import difflib
 import importlib.resources
 import json
 import math
@@ -27,7 +26,7 @@ from typing import Any, NoReturn
 import numpy as np
 import rpr3gen_generated as generated
 
-from rpr3gen.errors import ModelError
+from rpr3gen.errors import ModelError, did_you_mean
 
 __all__ = ["ACTUATIONS", "LEGS", "PARAM_NAMES", "Model", "load_model", "model_from_dict"]
 
@@ -204,7 +203,7 @@ class _Reader:
             self.fail("name", f"must be a non-empty string, got {_describe(name)}")
         actuation = self.required(data, "actuation", "actuation")
         if actuation not in ACTUATIONS:
-            hint = _suggest(actuation, ACTUATIONS) if isinstance(actuation, str) else ""
+            hint = did_you_mean(actuation, ACTUATIONS) if isinstance(actuation, str) else ""
             self.fail(
                 "actuation",
                 f"must be one of {_quoted(ACTUATIONS)}, got {_describe(actuation)}{hint}",
@@ -246,7 +245,7 @@ class _Reader:
         for key in table:
             dotted = f"{prefix}{key}"
             if key not in schema:
-                hint = _suggest(str(key), list(schema)) or self.elsewhere(str(key), prefix)
+                hint = did_you_mean(str(key), schema) or self.elsewhere(str(key), prefix)
                 self.fail(dotted, f"unknown key{hint}")
             sub = schema[key]
             if isinstance(sub, dict):
@@ -457,11 +456,6 @@ def _describe(value: Any) -> str:
     if isinstance(value, Real):
         return repr(int(value)) if isinstance(value, int | np.integer) else repr(float(value))
     return f"a value of type {type(value).__name__}"
-
-
-def _suggest(word: str, choices: Sequence[str]) -> str:
-    match = difflib.get_close_matches(word, choices, n=1, cutoff=0.6)
-    return f"; did you mean '{match[0]}'?" if match else ""
 
 
 def _quoted(words: Sequence[str]) -> str:

@@ -21,7 +21,7 @@ from typing import TextIO
 import numpy as np
 
 from rpr3gen.atomic import write_csv_table
-from rpr3gen.errors import InputTypeError, TrajectoryError
+from rpr3gen.errors import InputTypeError, TrajectoryError, did_you_mean
 
 __all__ = [
     "CSV_COLUMNS",
@@ -42,6 +42,12 @@ PAPER_TRAJECTORIES: Mapping[str, tuple[float, float, float]] = MappingProxyType(
     }
 )
 """Amplitudes ``(x*, y*, phi*)`` (m, m, rad) of the paper's motions, eq. (3)."""
+
+DEFAULT_SAMPLES = 301
+"""Samples of a paper trajectory unless told otherwise (one every 10 ms over the 3 s)."""
+
+DEFAULT_DURATION = 3.0
+"""Duration of the paper's motions, s (Δt of eq. 3)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -78,7 +84,9 @@ class Trajectory:
         return int(self.t.size)
 
 
-def paper_trajectory(name: str, samples: int = 301, duration: float = 3.0) -> Trajectory:
+def paper_trajectory(
+    name: str, samples: int = DEFAULT_SAMPLES, duration: float = DEFAULT_DURATION
+) -> Trajectory:
     """Sample one of the paper's motions, eq. (3).
 
     ``x/x* = y/y* = phi/phi* = 1 - cos(pi t / duration)`` for ``t`` in ``[0, duration]``: the
@@ -95,8 +103,7 @@ def paper_trajectory(name: str, samples: int = 301, duration: float = 3.0) -> Tr
         InputTypeError: If ``samples`` is not an integer or ``duration`` not a number.
     """
     if name not in PAPER_TRAJECTORIES:
-        match = difflib.get_close_matches(str(name), list(PAPER_TRAJECTORIES), n=1)
-        hint = f"; did you mean '{match[0]}'?" if match else ""
+        hint = did_you_mean(str(name), PAPER_TRAJECTORIES)
         choices = " or ".join(PAPER_TRAJECTORIES)
         raise TrajectoryError(f"unknown trajectory {name!r}: choose {choices}{hint}")
     if isinstance(samples, bool) or not isinstance(samples, int | np.integer):
