@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import errno
 import os
 import struct
 import subprocess
@@ -102,6 +103,35 @@ def test_bad_mode_and_bad_encoding(tmp_path: Path) -> None:
 def test_missing_folder_raises_oserror(tmp_path: Path) -> None:
     with pytest.raises(FileNotFoundError), atomic_write(tmp_path / "no" / "such.txt") as f:
         f.write("x")
+
+
+def test_errors_name_the_file_asked_for_never_the_temporary_one(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # A folder in the target's place: the rename fails.
+    folder = tmp_path / "taken"
+    folder.mkdir()
+    with pytest.raises(IsADirectoryError) as info, atomic_write(folder) as f:
+        f.write("x")
+    assert info.value.filename == str(folder)
+    assert ".tmp" not in str(info.value)
+    # The disk fills up while writing (such errors carry no file name).
+    target = tmp_path / "full.csv"
+    with pytest.raises(OSError, match="No space left") as info, atomic_write(target) as f:
+        raise OSError(errno.ENOSPC, "No space left on device")
+    assert info.value.errno == errno.ENOSPC
+    assert info.value.filename == str(target)
+
+    # The temporary file cannot be created (e.g. /proc, a read-only folder).
+    def refuse(*, prefix: str, suffix: str, dir: str) -> tuple[int, str]:
+        raise PermissionError(errno.EACCES, "Permission denied", f"{dir}/{prefix}abc{suffix}")
+
+    monkeypatch.setattr("tempfile.mkstemp", refuse)
+    with pytest.raises(PermissionError) as info, atomic_write("some/file.csv"):
+        pass
+    assert info.value.filename == "some/file.csv"
+    assert ".tmp" not in str(info.value)
+    assert leftovers(tmp_path, {"taken"}) == []
 
 
 # -- results CSV -------------------------------------------------------------------------------

@@ -222,3 +222,32 @@ def test_version(capsys: pytest.CaptureFixture) -> None:
     assert info.value.code == 0
     assert capsys.readouterr().out == f"rpr3gen {rpr3gen.__version__}\n"
     assert rpr3gen.__version__ == importlib.metadata.version("rpr3gen")
+
+
+# -- errors name the user's files --------------------------------------------------------------
+
+
+def test_output_paths_in_the_way_are_refused_before_any_work(tmp_path: Path) -> None:
+    (tmp_path / "afile").write_text("")
+    (tmp_path / "adir").mkdir()
+    cases = [
+        (["--out", "adir"], "adir: cannot write the CSV: it is a folder"),
+        (["--plots", "afile"], "afile: cannot write the figures: it is a file, not a folder"),
+        (["--out", "afile/x.csv"], "afile/x.csv: cannot write the CSV: afile is a file"),
+        (["--out", "new.csv", "--plots", "afile/sub"], "afile/sub: cannot write the figures"),
+    ]
+    for args, message in cases:
+        result = _cli("simulate", *args, cwd=tmp_path)
+        assert result.returncode == 2
+        assert result.stderr.startswith(f"rpr3gen: error: {message}"), result.stderr
+        assert result.stderr.count("\n") == 1
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["adir", "afile"]
+    assert list((tmp_path / "adir").iterdir()) == []
+
+
+@pytest.mark.skipif(not Path("/proc/self").is_dir(), reason="needs Linux's /proc")
+def test_an_unwritable_out_names_the_users_file(tmp_path: Path) -> None:
+    result = _cli("simulate", "--out", "/proc/x.csv", cwd=tmp_path)
+    assert result.returncode == 2
+    assert result.stderr.startswith("rpr3gen: error: /proc/x.csv: cannot write: ")
+    assert ".tmp" not in result.stderr

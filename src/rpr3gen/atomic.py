@@ -41,7 +41,8 @@ def atomic_write(path: str | os.PathLike[str], mode: str = "w", **kw: Any) -> It
 
     Raises:
         InputError: For a mode other than a plain write mode.
-        OSError: If the temporary file cannot be created, written or renamed.
+        OSError: If the temporary file cannot be created, written or renamed; its
+            ``filename`` is ``path`` as given, never the temporary file's name.
     """
     if mode not in _WRITE_MODES:
         raise InputError(f"atomic_write: mode must be 'w' or 'wb', got {mode!r}")
@@ -49,7 +50,10 @@ def atomic_write(path: str | os.PathLike[str], mode: str = "w", **kw: Any) -> It
         kw.setdefault("encoding", "utf-8")
     target = os.path.abspath(os.fspath(path))
     folder, name = os.path.split(target)
-    fd, tmp = tempfile.mkstemp(prefix=f".{name}.", suffix=".tmp", dir=folder)
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{name}.", suffix=".tmp", dir=folder)
+    except OSError as exc:
+        raise _about(exc, path) from exc
     try:
         f = os.fdopen(fd, mode, **kw)
     except BaseException:
@@ -64,11 +68,21 @@ def atomic_write(path: str | os.PathLike[str], mode: str = "w", **kw: Any) -> It
             os.fsync(f.fileno())
         os.chmod(tmp, _mode_for(target))
         os.replace(tmp, target)
-    except BaseException:
+    except BaseException as exc:
         with contextlib.suppress(OSError):
             os.unlink(tmp)
+        if isinstance(exc, OSError) and exc.filename in (None, tmp):
+            raise _about(exc, path) from exc
         raise
     _fsync_folder(folder)
+
+
+def _about(exc: OSError, path: str | os.PathLike[str]) -> OSError:
+    """The same error about the file the caller named, not its temporary file (or no file).
+
+    The errno is kept, so the class is too (``PermissionError``, ``IsADirectoryError`` ...).
+    """
+    return OSError(exc.errno, f"cannot write: {exc.strerror or exc}", os.fspath(path))
 
 
 def write_results_csv(

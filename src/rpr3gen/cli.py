@@ -194,6 +194,22 @@ def _screen(
             out[name] = np.where(invalid.mask, np.nan, out[name])
 
 
+def _check_destination(path: Path, what: str, *, folder: bool) -> None:
+    """Refuse, before any work, an output path that an existing file or folder stands in the way of.
+
+    ``path`` is the file (``folder=False``) or the folder to be written; folders missing on the
+    way are created later.
+    """
+    if not folder and path.is_dir():
+        raise Rpr3genError(f"{path}: cannot write {what}: it is a folder")
+    for part in (path, *path.parents) if folder else path.parents:
+        if part.exists():
+            if not part.is_dir():
+                it = "it" if part == path else str(part)
+                raise Rpr3genError(f"{path}: cannot write {what}: {it} is a file, not a folder")
+            return
+
+
 def simulate(
     model: Model,
     name: str,
@@ -212,6 +228,10 @@ def simulate(
 
     if not 0.0 <= min_conditioning < 1.0:
         raise InputError(f"min_conditioning: must be in [0, 1), got {min_conditioning!r}")
+    if out_csv:
+        _check_destination(Path(out_csv), "the CSV", folder=False)
+    if plots_dir:
+        _check_destination(Path(plots_dir), "the figures", folder=True)
     out = inverse_dynamics(model, traj.q, traj.qd, traj.qdd, backend=backend, progress=True)
     _screen(model, traj, out, min_conditioning, allow_invalid)
     if out_csv:
