@@ -251,3 +251,59 @@ def test_an_unwritable_out_names_the_users_file(tmp_path: Path) -> None:
     assert result.returncode == 2
     assert result.stderr.startswith("rpr3gen: error: /proc/x.csv: cannot write: ")
     assert ".tmp" not in result.stderr
+
+
+# -- what --allow-invalid dropped is reported --------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("name", "threshold", "spans"),
+    [
+        ("rectilinear", "0.8", ((182, 300),)),  # conditioning falls all along this motion
+        ("rotation", "0.98", ((0, 90), (240, 300))),  # ... and rises, then falls, along this one
+    ],
+)
+def test_allow_invalid_reports_how_many_rows_were_refused_and_when(
+    name: str,
+    threshold: str,
+    spans: tuple[tuple[int, int], ...],
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture,
+) -> None:
+    out_csv = tmp_path / "o.csv"
+    argv = [
+        "simulate",
+        "--trajectory",
+        name,
+        "--min-conditioning",
+        threshold,
+        "--out",
+        str(out_csv),
+    ]
+    assert main([*argv, "--allow-invalid"]) == 0
+    captured = capsys.readouterr()
+    traj = rpr3gen.paper_trajectory(name)
+    conditioning = rpr3gen.inverse_dynamics(rpr3gen.load_model(), traj.q, traj.qd, traj.qdd)[
+        "conditioning"
+    ]
+    refused = conditioning < float(threshold)
+    expected = np.zeros(len(traj), dtype=bool)
+    for first, last in spans:
+        expected[first : last + 1] = True
+    np.testing.assert_array_equal(refused, expected)  # the spans above are the right ones
+    when = ", ".join(f"{traj.t[a]:.6g} to {traj.t[b]:.6g} s" for a, b in spans)
+    count = int(expected.sum())
+    line = f"{count} of 301 samples refused and written as NaN, t = {when} (first: conditioning"
+    assert captured.err.count("\n") == 1, captured.err
+    assert captured.err.startswith(f"rpr3gen: warning: {name}: {line}")
+    assert line in captured.out
+    assert f"the peaks are of the {301 - count} others" in captured.out
+    _, table = _read(out_csv)
+    np.testing.assert_array_equal(np.isnan(table[:, HEADER.index("m10_A")]), expected)
+    # Without the flag: refused at the first of them, nothing written.
+    out_csv.unlink()
+    assert main(argv) == 2
+    assert f"t = {traj.t[spans[0][0]]:.6g} s (sample {spans[0][0] + 1} of 301)" in (
+        capsys.readouterr().err
+    )
+    assert not out_csv.exists()

@@ -28,7 +28,7 @@ from rpr3gen.trajectory import (
     paper_trajectory,
     read_trajectory_csv,
 )
-from rpr3gen.validity import DEFAULT_MIN_CONDITIONING, invalid_samples
+from rpr3gen.validity import DEFAULT_MIN_CONDITIONING, Invalid, invalid_samples
 
 EXIT_ERROR = 2
 
@@ -178,11 +178,15 @@ def _screen(
     out: dict[str, np.ndarray],
     min_conditioning: float,
     allow_invalid: bool,
-) -> None:
-    """Refuse a trajectory through an invalid pose, or blank those rows when allowed."""
+) -> Invalid | None:
+    """Refuse a trajectory through an invalid pose, or blank those rows when allowed.
+
+    Returns:
+        The samples blanked (written as NaN), or None when every sample is valid.
+    """
     invalid = invalid_samples(model, out, min_conditioning)
     if invalid is None:
-        return
+        return None
     if not allow_invalid:
         k = invalid.first
         raise Rpr3genError(
@@ -192,6 +196,29 @@ def _screen(
     for name in OUTPUT_NAMES:
         if name != "conditioning":
             out[name] = np.where(invalid.mask, np.nan, out[name])
+    return invalid
+
+
+def _spans(t: np.ndarray, mask: np.ndarray, most: int = 3) -> str:
+    """When ``mask`` holds, e.g. ``"t = 0.2 s, 1.17 to 3 s"``: its runs, the first ``most``."""
+    edges = np.flatnonzero(np.diff(np.concatenate([[0], mask.astype(np.int8), [0]])))
+    runs = list(zip(edges[::2], edges[1::2] - 1, strict=True))  # first and last sample of each
+    parts = [f"{t[a]:.6g} s" if a == b else f"{t[a]:.6g} to {t[b]:.6g} s" for a, b in runs[:most]]
+    more = f" and {len(runs) - most} more spans" if len(runs) > most else ""
+    return "t = " + ", ".join(parts) + more
+
+
+def _refused(traj: Trajectory, invalid: Invalid) -> str:
+    """One line: how many samples were refused, when, and why the first one was."""
+    count = int(np.count_nonzero(invalid.mask))
+    return (
+        f"{count} of {len(traj.t)} samples refused and written as NaN, "
+        f"{_spans(traj.t, invalid.mask)} (first: {invalid.reason})"
+    )
+
+
+def _warn(message: str) -> None:
+    print(f"rpr3gen: warning: {message}", file=sys.stderr)
 
 
 def _check_destination(path: Path, what: str, *, folder: bool) -> None:
@@ -219,10 +246,14 @@ def simulate(
     plots_dir: str | None,
     min_conditioning: float = DEFAULT_MIN_CONDITIONING,
     allow_invalid: bool = False,
-) -> dict[str, np.ndarray]:
+) -> tuple[dict[str, np.ndarray], Invalid | None]:
     """Evaluate, screen, and write the CSV and figures of one trajectory.
 
     Nothing is written unless the whole trajectory is valid (or ``allow_invalid``).
+
+    Returns:
+        Every output by name, shape ``(n,)``, and the samples refused (their outputs, but
+        ``conditioning``, are NaN; None when there are none, always unless ``allow_invalid``).
     """
     from rpr3gen.atomic import write_results_csv
 
@@ -233,7 +264,7 @@ def simulate(
     if plots_dir:
         _check_destination(Path(plots_dir), "the figures", folder=True)
     out = inverse_dynamics(model, traj.q, traj.qd, traj.qdd, backend=backend, progress=True)
-    _screen(model, traj, out, min_conditioning, allow_invalid)
+    invalid = _screen(model, traj, out, min_conditioning, allow_invalid)
     if out_csv:
         Path(out_csv).parent.mkdir(parents=True, exist_ok=True)
         write_results_csv(out_csv, traj.t, traj.q, out, OUTPUT_NAMES)
@@ -248,11 +279,21 @@ def simulate(
             title=f"{name} ({model.name})",
             actuation=model.actuation,
         )
-    return out
+    return out, invalid
 
 
-def _summary(name: str, model: Model, traj: Trajectory, out: dict[str, np.ndarray]) -> str:
-    lines = [f"{name}: {len(traj.t)} samples over {traj.t[-1] - traj.t[0]:g} s, model {model.name}"]
+def _summary(
+    name: str,
+    model: Model,
+    traj: Trajectory,
+    out: dict[str, np.ndarray],
+    invalid: Invalid | None = None,
+) -> str:
+    n = len(traj.t)
+    lines = [f"{name}: {n} samples over {traj.t[-1] - traj.t[0]:g} s, model {model.name}"]
+    if invalid is not None:
+        valid = n - int(np.count_nonzero(invalid.mask))
+        lines.append(f"  {_refused(traj, invalid)}; the peaks are of the {valid} others")
     lines.append(f"  {'peak |value|':<12} {'leg A':>12} {'leg B':>12} {'leg C':>12}")
     for family in ("m10", "f21z", "f10x", "f10y", "f21y", "m21", "f32y", "f32z"):
         peaks = [float(np.nanmax(np.abs(out[f"{family}_{leg}"]), initial=0.0)) for leg in "ABC"]
@@ -263,7 +304,7 @@ def _summary(name: str, model: Model, traj: Trajectory, out: dict[str, np.ndarra
 def _cmd_simulate(args: argparse.Namespace) -> int:
     model = load_model(args.model)
     name, traj = _trajectory(args)
-    out = simulate(
+    out, invalid = simulate(
         model,
         name,
         traj,
@@ -273,7 +314,9 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
         min_conditioning=args.min_conditioning,
         allow_invalid=args.allow_invalid,
     )
-    print(_summary(name, model, traj, out))
+    if invalid is not None:
+        _warn(f"{name}: {_refused(traj, invalid)}")
+    print(_summary(name, model, traj, out, invalid))
     return 0
 
 
@@ -283,7 +326,7 @@ def _cmd_paper(args: argparse.Namespace) -> int:
     summaries = []  # printed once every file is written, so a closed stdout stops nothing
     for name in PAPER_TRAJECTORIES:
         traj = paper_trajectory(name)
-        out = simulate(
+        out, _ = simulate(
             model, name, traj, args.backend, str(root / f"{name}.csv"), str(root / "figures")
         )
         summaries.append(_summary(name, model, traj, out))
