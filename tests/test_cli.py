@@ -120,13 +120,13 @@ def test_singular_pose_is_refused_with_its_time(tmp_path: Path) -> None:
     y = p["yB1"] - p["yB3"]
     t = np.array([0.0, 0.5, 1.0])
     q = np.array([[0.0, 0.0, 0.0], [x / 2, y / 2, 0.0], [x, y, 0.0]])
-    z = np.zeros_like(q)
+    qd = np.tile([x, y, 0.0], (3, 1))  # at constant velocity
     motion = tmp_path / "through.csv"
-    write_trajectory_csv(motion, Trajectory(t, q, z, z))
+    write_trajectory_csv(motion, Trajectory(t, q, qd, np.zeros_like(q)))
     out = tmp_path / "o.csv"
     result = _cli("simulate", "--trajectory", str(motion), "--out", str(out), cwd=tmp_path)
     assert result.returncode == 2
-    assert "t = 1 s" in result.stderr
+    assert result.stderr.startswith("rpr3gen: error: t = 1 s"), result.stderr
     assert not out.exists()
 
 

@@ -10,15 +10,22 @@ import argparse
 import contextlib
 import os
 import sys
-from collections.abc import Sequence
+import warnings
+from collections.abc import Iterator, Sequence
 from pathlib import Path
-from typing import NoReturn
+from typing import NoReturn, TextIO
 
 import numpy as np
 
 from rpr3gen import __version__
 from rpr3gen.backends import BACKENDS, OUTPUT_NAMES, inverse_dynamics
-from rpr3gen.errors import InputError, Rpr3genError, TrajectoryError, did_you_mean
+from rpr3gen.errors import (
+    InputError,
+    Rpr3genError,
+    Rpr3genWarning,
+    TrajectoryError,
+    did_you_mean,
+)
 from rpr3gen.model import Model, load_model
 from rpr3gen.trajectory import (
     DEFAULT_DURATION,
@@ -89,6 +96,15 @@ def _parser() -> argparse.ArgumentParser:
         help=f"duration of a paper trajectory, s (default: {DEFAULT_DURATION:g})",
     )
     sim.add_argument(
+        "--smoothing",
+        type=float,
+        metavar="S",
+        help="for a CSV file of positions only (t,x,y,phi): RMS deviation allowed between the "
+        "quintic spline whose derivatives give the velocities and accelerations and the "
+        "positions, m for x, y and rad for phi; give the noise level of measured positions "
+        "(default: 0, through every sample)",
+    )
+    sim.add_argument(
         "--backend",
         choices=BACKENDS,
         default="numpy",
@@ -156,6 +172,11 @@ def _trajectory(args: argparse.Namespace) -> tuple[str, Trajectory]:
     timing = {"samples": args.samples, "duration": args.duration}
     given = [f"--{key}" for key, value in timing.items() if value is not None]
     if args.trajectory in PAPER_TRAJECTORIES:
+        if args.smoothing is not None:
+            raise TrajectoryError(
+                "--smoothing: only for a trajectory CSV file of positions; "
+                f"{args.trajectory!r} has analytic derivatives"
+            )
         kwargs = {key: value for key, value in timing.items() if value is not None}
         return args.trajectory, paper_trajectory(args.trajectory, **kwargs)
     path = Path(args.trajectory)
@@ -169,7 +190,7 @@ def _trajectory(args: argparse.Namespace) -> tuple[str, Trajectory]:
         raise TrajectoryError(
             f"{' and '.join(given)}: only for the paper trajectories; {path} has its own times"
         )
-    return path.stem, read_trajectory_csv(path)
+    return path.stem, read_trajectory_csv(path, smoothing=args.smoothing)
 
 
 def _screen(
@@ -219,6 +240,30 @@ def _refused(traj: Trajectory, invalid: Invalid) -> str:
 
 def _warn(message: str) -> None:
     print(f"rpr3gen: warning: {message}", file=sys.stderr)
+
+
+@contextlib.contextmanager
+def _warnings_as_lines() -> Iterator[None]:
+    """Show the package's warnings as one line each, ``rpr3gen: warning: <msg>``, every time."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("always", Rpr3genWarning)
+        show = warnings.showwarning
+
+        def show_ours(
+            message: Warning | str,
+            category: type[Warning],
+            filename: str,
+            lineno: int,
+            file: TextIO | None = None,
+            line: str | None = None,
+        ) -> None:
+            if issubclass(category, Rpr3genWarning):
+                _warn(str(message))
+            else:
+                show(message, category, filename, lineno, file, line)
+
+        warnings.showwarning = show_ours
+        yield
 
 
 def _check_destination(path: Path, what: str, *, folder: bool) -> None:
@@ -385,7 +430,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         "generate": _cmd_generate,
     }
     try:
-        status = commands[args.command](args)
+        with _warnings_as_lines():
+            status = commands[args.command](args)
         sys.stdout.flush()  # a reader that went away shows here, not at the interpreter's exit
         return status
     except BrokenPipeError:

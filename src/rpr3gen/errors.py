@@ -13,6 +13,12 @@ derive from :class:`ValueError`, and those about a value of the wrong type from
     ├── TrajectoryError(Rpr3genError, ValueError)   a trajectory file or request
     ├── InputError(Rpr3genError, ValueError)        an array or argument of the Python API
     └── InputTypeError(Rpr3genError, TypeError)     an argument of the wrong type
+
+Warnings (``warnings.warn``) derive from :class:`Rpr3genWarning`, a :class:`UserWarning`; the
+command line prints each as one line ``rpr3gen: warning: <msg>`` on stderr::
+
+    Rpr3genWarning(UserWarning)
+    └── TrajectoryWarning   a trajectory file's derivatives disagree with its positions
 """
 
 from __future__ import annotations
@@ -25,7 +31,9 @@ __all__ = [
     "InputTypeError",
     "ModelError",
     "Rpr3genError",
+    "Rpr3genWarning",
     "TrajectoryError",
+    "TrajectoryWarning",
     "did_you_mean",
 ]
 
@@ -48,6 +56,15 @@ class InputError(Rpr3genError, ValueError):
 
 class InputTypeError(Rpr3genError, TypeError):
     """An argument given to the Python API has the wrong type."""
+
+
+class Rpr3genWarning(UserWarning):
+    """Base class of the package's warnings: the input is usable but likely not what was meant."""
+
+
+class TrajectoryWarning(Rpr3genWarning):
+    """A trajectory's velocities or accelerations disagree with its positions, or its spline
+    could not be fitted as asked."""
 
 
 def did_you_mean(word: str, choices: Iterable[str]) -> str:
