@@ -3,7 +3,8 @@
 Run from anywhere with the project's interpreter (rpr3gen installed with the ``dev`` extra)::
 
     python benchmarks/run.py                # full run, a few minutes; writes benchmarks/results.md
-    python benchmarks/run.py --quick        # fewer repeats, no 10^7-sample NumPy run
+    python benchmarks/run.py --quick        # fewer repeats, no 10^7-sample NumPy run; writes
+                                            # benchmarks/results-quick.md, not results.md
     python benchmarks/run.py --out FILE.md  # write the Markdown elsewhere
 
 It prints the report (Markdown) on stdout, progress on stderr, and writes the same Markdown to
@@ -1344,10 +1345,21 @@ def section_targets(results: dict[str, Any]) -> str:
     return table(["target", "measured", "goal", "result", "margin"], rows) + "\n"
 
 
+def report_path(out: str | None, quick: bool) -> Path:
+    """Where the report goes: ``out`` if given, else results.md, or results-quick.md for --quick."""
+    if out:
+        return Path(out)
+    return HERE / ("results-quick.md" if quick else "results.md")
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n", 1)[0])
     parser.add_argument("--quick", action="store_true", help="fewer repeats, no 10^7 NumPy run")
-    parser.add_argument("--out", default=str(HERE / "results.md"), help="Markdown report file")
+    parser.add_argument(
+        "--out",
+        help="Markdown report file (default: benchmarks/results.md, or results-quick.md with "
+        "--quick, so a quick run never replaces the committed full results)",
+    )
     parser.add_argument("--worker", help=argparse.SUPPRESS)
     parser.add_argument("--args", default="{}", help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
@@ -1399,7 +1411,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         lines += [f"## {title}", "", body]
     report = "\n".join(lines).rstrip() + "\n"
     print(report)
-    out = Path(args.out)
+    out = report_path(args.out, args.quick)
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(report)
     log(f"wrote {out}")
