@@ -61,6 +61,13 @@ def test_smoothing_measured_positions() -> None:
     assert np.sqrt(np.mean((smoothed.q - measured) ** 2)) <= 1.001 * noise
 
 
+def test_a_smoothing_too_small_for_the_noise_is_reported() -> None:
+    exact = paper_trajectory("rectilinear")
+    measured = exact.q + np.random.default_rng(0).normal(0.0, 1e-5, exact.q.shape)
+    with pytest.warns(TrajectoryWarning, match=r"spline of (x|y|phi) could not meet smoothing"):
+        Trajectory.from_positions(exact.t, measured, smoothing=1e-8, source="m.csv")
+
+
 def test_cli_runs_a_positions_only_file(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
     exact = paper_trajectory("rectilinear")
     motion = _positions_file(tmp_path / "planned.csv", exact)

@@ -1,7 +1,10 @@
-"""The ``rpr3gen`` command: ``simulate``, ``paper`` (the paper's two examples) and ``generate``.
+"""The ``rpr3gen`` command: ``simulate``, ``paper`` (the paper's two examples), ``params`` and
+``generate``.
 
 Every failure is one line on stderr (``rpr3gen: error: ...``) and exit status 2; ``--debug``
-shows the traceback instead. Output files are written atomically.
+shows the traceback instead. The package's warnings are one line each (``rpr3gen: warning:
+...``). Output files are written atomically, and a reader of stdout that goes away ends the
+command quietly.
 """
 
 from __future__ import annotations
@@ -169,16 +172,15 @@ def _parser() -> argparse.ArgumentParser:
 
 
 def _trajectory(args: argparse.Namespace) -> tuple[str, Trajectory]:
-    timing = {"samples": args.samples, "duration": args.duration}
-    given = [f"--{key}" for key, value in timing.items() if value is not None]
+    given = {"samples": args.samples, "duration": args.duration}
+    timing = {key: value for key, value in given.items() if value is not None}
     if args.trajectory in PAPER_TRAJECTORIES:
         if args.smoothing is not None:
             raise TrajectoryError(
                 "--smoothing: only for a trajectory CSV file of positions; "
                 f"{args.trajectory!r} has analytic derivatives"
             )
-        kwargs = {key: value for key, value in timing.items() if value is not None}
-        return args.trajectory, paper_trajectory(args.trajectory, **kwargs)
+        return args.trajectory, paper_trajectory(args.trajectory, **timing)
     path = Path(args.trajectory)
     if path.suffix.lower() != ".csv" and not path.exists():
         names = ", ".join(PAPER_TRAJECTORIES)
@@ -186,10 +188,9 @@ def _trajectory(args: argparse.Namespace) -> tuple[str, Trajectory]:
         raise TrajectoryError(
             f"--trajectory: {args.trajectory!r} is neither {names} nor a CSV file{hint}"
         )
-    if given:
-        raise TrajectoryError(
-            f"{' and '.join(given)}: only for the paper trajectories; {path} has its own times"
-        )
+    if timing:
+        options = " and ".join(f"--{key}" for key in timing)
+        raise TrajectoryError(f"{options}: only for a paper trajectory; {path} has its own times")
     return path.stem, read_trajectory_csv(path, smoothing=args.smoothing)
 
 

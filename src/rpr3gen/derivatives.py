@@ -24,7 +24,14 @@ import numpy as np
 
 from rpr3gen.errors import InputError, InputTypeError, TrajectoryError, TrajectoryWarning
 
-__all__ = ["MIN_SAMPLES", "MISMATCH_TOLERANCE", "SPLINE_DEGREE", "differentiate", "mismatch"]
+__all__ = [
+    "MIN_SAMPLES",
+    "MISMATCH_TOLERANCE",
+    "SPLINE_DEGREE",
+    "check_smoothing",
+    "differentiate",
+    "mismatch",
+]
 
 SPLINE_DEGREE = 5
 """Degree of the smoothing spline: quintic, so accelerations are smooth (C² up to the ends)."""
@@ -91,8 +98,13 @@ def differentiate(
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             spline = make_splrep(t, q[:, j], k=SPLINE_DEGREE, s=n * smoothing**2)
-        if caught:
-            reason = " ".join(str(caught[0].message).split())
+        for caught_one in caught:
+            if not issubclass(caught_one.category, RuntimeWarning):  # not FITPACK's report
+                warnings.warn_explicit(
+                    caught_one.message, caught_one.category, caught_one.filename, caught_one.lineno
+                )
+                continue
+            reason = " ".join(str(caught_one.message).split())
             warnings.warn(
                 f"{source}: the spline of {name} could not meet smoothing {smoothing:g} and is "
                 f"used as fitted (SciPy: {reason})",
