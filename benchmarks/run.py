@@ -25,6 +25,12 @@ from rpr3bench import report, sections, workers
 from rpr3bench.common import BENCH, log
 
 
+def report_path(out: str | None, quick: bool) -> Path:
+    """Where the report goes: ``--out``, else ``results.md``, or ``results-quick.md`` with
+    ``--quick``, so that a quick run never replaces the committed full results."""
+    return Path(out) if out else BENCH / ("results-quick.md" if quick else "results.md")
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=(__doc__ or "").split("\n", 1)[0])
     parser.add_argument("--quick", action="store_true", help="fewer repeats, no 10^7 NumPy run")
@@ -48,7 +54,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     command = "python benchmarks/run.py" + (" --quick" if args.quick else "")
     text = report.document(command, info, results, parts)
     print(text)
-    out = Path(args.out or BENCH / ("results-quick.md" if args.quick else "results.md"))
+    out = report_path(args.out, args.quick)
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(text)
     log(f"wrote {out}")

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import errno
 import os
 import struct
 import subprocess
@@ -11,9 +12,17 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+import rpr3gen
 import rpr3gen.plots
 from rpr3gen.atomic import atomic_write, write_csv_table, write_results_csv
-from rpr3gen.plots import DPI, FIGSIZE, plot_families, plotted_families
+from rpr3gen.plots import (
+    DPI,
+    FIGSIZE,
+    coinciding_legs,
+    family_figure,
+    plot_families,
+    plotted_families,
+)
 from rpr3gen.trajectory import paper_trajectory
 
 OLD = b"old contents\x00\xff\n"
@@ -102,6 +111,35 @@ def test_bad_mode_and_bad_encoding(tmp_path: Path) -> None:
 def test_missing_folder_raises_oserror(tmp_path: Path) -> None:
     with pytest.raises(FileNotFoundError), atomic_write(tmp_path / "no" / "such.txt") as f:
         f.write("x")
+
+
+def test_errors_name_the_file_asked_for_never_the_temporary_one(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # A folder in the target's place: the rename fails.
+    folder = tmp_path / "taken"
+    folder.mkdir()
+    with pytest.raises(IsADirectoryError) as info, atomic_write(folder) as f:
+        f.write("x")
+    assert info.value.filename == str(folder)
+    assert ".tmp" not in str(info.value)
+    # The disk fills up while writing (such errors carry no file name).
+    target = tmp_path / "full.csv"
+    with pytest.raises(OSError, match="No space left") as info, atomic_write(target) as f:
+        raise OSError(errno.ENOSPC, "No space left on device")
+    assert info.value.errno == errno.ENOSPC
+    assert info.value.filename == str(target)
+
+    # The temporary file cannot be created (e.g. /proc, a read-only folder).
+    def refuse(*, prefix: str, suffix: str, dir: str) -> tuple[int, str]:
+        raise PermissionError(errno.EACCES, "Permission denied", f"{dir}/{prefix}abc{suffix}")
+
+    monkeypatch.setattr("tempfile.mkstemp", refuse)
+    with pytest.raises(PermissionError) as info, atomic_write("some/file.csv"):
+        pass
+    assert info.value.filename == "some/file.csv"
+    assert ".tmp" not in str(info.value)
+    assert leftovers(tmp_path, {"taken"}) == []
 
 
 # -- results CSV -------------------------------------------------------------------------------
@@ -260,3 +298,41 @@ def test_plotting_does_not_use_pyplot(tmp_path: Path) -> None:
     )
     assert result.returncode == 0, result.stderr
     assert len(list(tmp_path.glob("p_*.png"))) == 9
+
+
+def test_coinciding_legs() -> None:
+    t = np.linspace(0.0, 1.0, 11)
+    a, b = np.sin(t), np.cos(t)
+    assert coinciding_legs([a, b, t]) == ()
+    assert coinciding_legs([a, b, a * (1 + 1e-12)]) == (("A", "C"),)
+    assert coinciding_legs([a, a, a]) == (("A", "B", "C"),)
+    assert coinciding_legs([0 * t, 0 * t, 0 * t]) == (("A", "B", "C"),)
+    nan_a = np.where(t > 0.5, np.nan, a)
+    assert coinciding_legs([nan_a, b, nan_a]) == (("A", "C"),)
+    assert coinciding_legs([a, a + 1e-6, b]) == ()
+
+
+def test_rotation_figures_keep_coinciding_legs_visible() -> None:
+    # In the paper's rotation the three legs move alike: phi10 and lambda21 coincide.
+    model = rpr3gen.load_model()
+    traj = paper_trajectory("rotation")
+    out = rpr3gen.inverse_dynamics(model, traj.q, traj.qd, traj.qdd)
+    for spec in plotted_families("revolute"):
+        legs = [out[f"{spec.family}_{leg}"] for leg in "ABC"]
+        fig = family_figure(traj.t, legs, spec, "rotation (paper)")
+        (ax,) = fig.axes
+        title = ax.get_title()
+        if spec.family in ("phi10", "lambda21"):
+            assert title.endswith("\n(legs A, B and C coincide)"), title
+        else:
+            assert "coincide" not in title, title
+        lines = ax.get_lines()
+        assert [line.get_label() for line in lines] == ["leg A", "leg B", "leg C"]
+        assert len({line.get_linestyle() for line in lines}) == 3
+        assert len({line.get_marker() for line in lines}) == 3
+        widths = [line.get_linewidth() for line in lines]
+        assert widths == sorted(widths, reverse=True)  # the later drawn, the narrower
+        assert all(line.get_markerfacecolor() == "none" for line in lines)  # hollow
+        starts_steps = [line.get_markevery() for line in lines]
+        marked = [set(range(start, len(traj.t), step)) for start, step in starts_steps]
+        assert len(set.union(*marked)) == sum(len(m) for m in marked)  # no two at one sample

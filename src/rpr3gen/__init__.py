@@ -7,27 +7,47 @@
 >>> out["m10_A"].shape
 (301,)
 
-The runtime imports numpy (and matplotlib for figures) only; regeneration lives in the package
-``rpr3gen_derive`` (folder ``derive/``) and writes ``rpr3gen_generated`` (folder ``generated/``).
+The runtime imports numpy (matplotlib for figures, scipy for trajectories of positions only);
+regeneration lives in the package ``rpr3gen_derive`` (folder ``derive/``) and writes
+``rpr3gen_generated`` (folder ``generated/``).
 """
 
+import importlib.metadata
+
 from rpr3gen.backends import BACKENDS, OUTPUT_NAMES, evaluate, inverse_dynamics
-from rpr3gen.errors import InputError, ModelError, Rpr3genError, TrajectoryError
+from rpr3gen.errors import (
+    InputError,
+    InputTypeError,
+    ModelError,
+    Rpr3genError,
+    Rpr3genWarning,
+    TrajectoryError,
+    TrajectoryWarning,
+)
 from rpr3gen.model import PARAM_NAMES, Model, load_model
 from rpr3gen.sample import SampleEvaluator
 from rpr3gen.trajectory import Trajectory, paper_trajectory, read_trajectory_csv
+
+try:
+    __version__ = importlib.metadata.version("rpr3gen")
+except importlib.metadata.PackageNotFoundError:  # the source tree on sys.path, not installed
+    __version__ = "0+unknown"
 
 __all__ = [
     "BACKENDS",
     "OUTPUT_NAMES",
     "PARAM_NAMES",
     "InputError",
+    "InputTypeError",
     "Model",
     "ModelError",
     "Rpr3genError",
+    "Rpr3genWarning",
     "SampleEvaluator",
     "Trajectory",
     "TrajectoryError",
+    "TrajectoryWarning",
+    "__version__",
     "evaluate",
     "inverse_dynamics",
     "load_model",

@@ -16,6 +16,8 @@ from typing import IO, Any
 
 import numpy as np
 
+from rpr3gen.errors import InputError
+
 __all__ = ["atomic_write", "write_csv_table", "write_results_csv"]
 
 _WRITE_MODES = frozenset({"w", "wt", "wb", "tw", "bw"})
@@ -38,16 +40,20 @@ def atomic_write(path: str | os.PathLike[str], mode: str = "w", **kw: Any) -> It
         The open temporary file.
 
     Raises:
-        ValueError: For a mode other than a plain write mode.
-        OSError: If the temporary file cannot be created, written or renamed.
+        InputError: For a mode other than a plain write mode.
+        OSError: If the temporary file cannot be created, written or renamed; its
+            ``filename`` is ``path`` as given, never the temporary file's name.
     """
     if mode not in _WRITE_MODES:
-        raise ValueError(f"atomic_write: mode must be 'w' or 'wb', got {mode!r}")
+        raise InputError(f"atomic_write: mode must be 'w' or 'wb', got {mode!r}")
     if "b" not in mode:
         kw.setdefault("encoding", "utf-8")
     target = os.path.abspath(os.fspath(path))
     folder, name = os.path.split(target)
-    fd, tmp = tempfile.mkstemp(prefix=f".{name}.", suffix=".tmp", dir=folder)
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{name}.", suffix=".tmp", dir=folder)
+    except OSError as exc:
+        raise _about(exc, path) from exc
     try:
         f = os.fdopen(fd, mode, **kw)
     except BaseException:
@@ -62,11 +68,21 @@ def atomic_write(path: str | os.PathLike[str], mode: str = "w", **kw: Any) -> It
             os.fsync(f.fileno())
         os.chmod(tmp, _mode_for(target))
         os.replace(tmp, target)
-    except BaseException:
+    except BaseException as exc:
         with contextlib.suppress(OSError):
             os.unlink(tmp)
+        if isinstance(exc, OSError) and exc.filename in (None, tmp):
+            raise _about(exc, path) from exc
         raise
     _fsync_folder(folder)
+
+
+def _about(exc: OSError, path: str | os.PathLike[str]) -> OSError:
+    """The same error about the file the caller named, not its temporary file (or no file).
+
+    The errno is kept, so the class is too (``PermissionError``, ``IsADirectoryError`` ...).
+    """
+    return OSError(exc.errno, f"cannot write: {exc.strerror or exc}", os.fspath(path))
 
 
 def write_results_csv(
@@ -89,25 +105,25 @@ def write_results_csv(
         names: Which outputs to write, in column order.
 
     Raises:
-        ValueError: If a shape is wrong, or a name is missing from ``outputs`` or repeated.
+        InputError: If a shape is wrong, or a name is missing from ``outputs`` or repeated.
         OSError: If the file cannot be written.
     """
     t = np.asarray(t, dtype=np.float64)
     q = np.asarray(q, dtype=np.float64)
     if t.ndim != 1:
-        raise ValueError(f"t must have shape (n,), got {t.shape}")
+        raise InputError(f"t must have shape (n,), got {t.shape}")
     n = t.size
     if q.shape != (n, 3):
-        raise ValueError(f"q must have shape ({n}, 3), got {q.shape}")
+        raise InputError(f"q must have shape ({n}, 3), got {q.shape}")
     if len(set(names)) != len(names):
-        raise ValueError("names must not repeat")
+        raise InputError("names must not repeat")
     columns = [t, q[:, 0], q[:, 1], q[:, 2]]
     for name in names:
         if name not in outputs:
-            raise ValueError(f"no output named {name!r}")
+            raise InputError(f"no output named {name!r}")
         value = np.asarray(outputs[name], dtype=np.float64)
         if value.shape not in ((n,), ()):
-            raise ValueError(f"output {name!r} must have shape ({n},), got {value.shape}")
+            raise InputError(f"output {name!r} must have shape ({n},), got {value.shape}")
         columns.append(np.broadcast_to(value, (n,)))
     write_csv_table(path, ["t", "x", "y", "phi", *names], np.column_stack(columns))
 
@@ -121,12 +137,12 @@ def write_csv_table(path: str | os.PathLike[str], header: Sequence[str], table: 
         table: Values, shape ``(n, len(header))``.
 
     Raises:
-        ValueError: If the table's shape does not match the header.
+        InputError: If the table's shape does not match the header.
         OSError: If the file cannot be written.
     """
     table = np.asarray(table, dtype=np.float64)
     if table.ndim != 2 or table.shape[1] != len(header):
-        raise ValueError(f"table must have shape (n, {len(header)}), got {table.shape}")
+        raise InputError(f"table must have shape (n, {len(header)}), got {table.shape}")
     with atomic_write(path, "w", newline="") as f:
         f.write(",".join(header) + "\n")
         for row in table:

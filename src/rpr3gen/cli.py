@@ -1,25 +1,44 @@
-"""The ``rpr3gen`` command: ``simulate``, ``paper`` (the paper's two examples) and ``generate``.
+"""The ``rpr3gen`` command: ``simulate``, ``paper`` (the paper's two examples), ``params`` and
+``generate``.
 
 Every failure is one line on stderr (``rpr3gen: error: ...``) and exit status 2; ``--debug``
-shows the traceback instead. Output files are written atomically.
+shows the traceback instead. The package's warnings are one line each (``rpr3gen: warning:
+...``). Output files are written atomically, and a reader of stdout that goes away ends the
+command quietly.
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
+import os
 import sys
-from collections.abc import Sequence
+import warnings
+from collections.abc import Iterator, Sequence
 from pathlib import Path
-from typing import NoReturn
+from typing import NoReturn, TextIO
 
 import numpy as np
 
-from rpr3gen import manifest
+from rpr3gen import __version__, manifest
 from rpr3gen.backends import BACKENDS, OUTPUT_NAMES, inverse_dynamics
-from rpr3gen.errors import Rpr3genError
+from rpr3gen.errors import (
+    InputError,
+    Rpr3genError,
+    Rpr3genWarning,
+    TrajectoryError,
+    did_you_mean,
+)
 from rpr3gen.model import ACTUATIONS, Model, load_model
-from rpr3gen.policy import DEFAULT_MIN_CONDITIONING, invalid_samples
-from rpr3gen.trajectory import PAPER_TRAJECTORIES, Trajectory, paper_trajectory, read_trajectory_csv
+from rpr3gen.policy import DEFAULT_MIN_CONDITIONING, Invalid, invalid_samples
+from rpr3gen.trajectory import (
+    DEFAULT_DURATION,
+    DEFAULT_SAMPLES,
+    PAPER_TRAJECTORIES,
+    Trajectory,
+    paper_trajectory,
+    read_trajectory_csv,
+)
 
 EXIT_ERROR = 2
 
@@ -31,71 +50,148 @@ class _Parser(argparse.ArgumentParser):
         self.exit(EXIT_ERROR, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
 
 
+def _conditioning_threshold(text: str) -> float:
+    """Type of ``--min-conditioning``: a number in [0, 1) (conditioning is 1 at best)."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
+    if not 0.0 <= value < 1.0:
+        raise argparse.ArgumentTypeError(
+            f"must be in [0, 1), got {text}: conditioning is at most 1, so a threshold of 1 "
+            "or more refuses every pose"
+        )
+    return value
+
+
 def _parser() -> argparse.ArgumentParser:
     parser = _Parser(
         prog="rpr3gen",
         description="Inverse dynamics of the 3-RPR planar parallel robot (Staicu), "
-        "from generated code.",
+        "from generated code. SI units throughout (m, rad, s, N, N·m).",
+        epilog="Run 'rpr3gen COMMAND --help' for the options of a command.",
     )
+    parser.add_argument("--version", action="version", version=f"rpr3gen {__version__}")
     parser.add_argument("--debug", action="store_true", help="show tracebacks on errors")
-    sub = parser.add_subparsers(
-        dest="command", required=True, metavar="COMMAND", parser_class=_Parser
-    )
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+    paper_model = "default: the paper's robot, models/paper.toml"
 
     sim = sub.add_parser("simulate", help="evaluate the inverse dynamics over a trajectory")
-    sim.add_argument("--model", metavar="FILE", help="model TOML file (default: the paper's)")
+    sim.add_argument("--model", metavar="FILE", help=f"model TOML file ({paper_model})")
     sim.add_argument(
         "--trajectory",
         default="rotation",
         metavar="NAME|FILE.csv",
-        help="'rotation' or 'rectilinear' (paper eq. 3) or a trajectory CSV (default: rotation)",
+        help="'rotation' or 'rectilinear' (the paper's motions, eq. 3), or a trajectory CSV "
+        "file (default: rotation)",
     )
-    sim.add_argument("--samples", type=int, default=301, help="samples of a paper trajectory")
-    sim.add_argument("--duration", type=float, default=3.0, help="duration of a paper trajectory")
-    sim.add_argument("--backend", choices=BACKENDS, default="numpy")
-    sim.add_argument("--out", metavar="FILE.csv", help="write every output as CSV")
-    sim.add_argument("--plots", metavar="DIR", help="write the paper's figures as PNG")
+    sim.add_argument(
+        "--samples",
+        type=int,
+        metavar="N",
+        help="number of samples of a paper trajectory, both ends included "
+        f"(default: {DEFAULT_SAMPLES})",
+    )
+    sim.add_argument(
+        "--duration",
+        type=float,
+        metavar="T",
+        help=f"duration of a paper trajectory, s (default: {DEFAULT_DURATION:g})",
+    )
+    sim.add_argument(
+        "--smoothing",
+        type=float,
+        metavar="S",
+        help="for a CSV file of positions only (t,x,y,phi): RMS deviation allowed between the "
+        "quintic spline whose derivatives give the velocities and accelerations and the "
+        "positions, m for x, y and rad for phi; give the noise level of measured positions "
+        "(default: 0, through every sample)",
+    )
+    sim.add_argument(
+        "--backend",
+        choices=BACKENDS,
+        default="numpy",
+        help="evaluate the generated NumPy or C code (default: numpy)",
+    )
+    sim.add_argument(
+        "--out",
+        metavar="FILE.csv",
+        help="write t,x,y,phi and every output as CSV, SI units (default: no file)",
+    )
+    sim.add_argument(
+        "--plots",
+        metavar="DIR",
+        help="write the paper's figures into DIR as PNG (default: no figures)",
+    )
     sim.add_argument(
         "--min-conditioning",
-        type=float,
+        type=_conditioning_threshold,
         default=DEFAULT_MIN_CONDITIONING,
         metavar="C",
-        help="refuse poses whose output 'conditioning' (0 = singular, 1 = best) is below C "
-        f"(default {DEFAULT_MIN_CONDITIONING:g})",
+        help="refuse poses whose output 'conditioning' (dimensionless, 0 = singular, 1 = best) "
+        f"is below C, 0 <= C < 1 (default: {DEFAULT_MIN_CONDITIONING:g})",
     )
     sim.add_argument(
         "--allow-invalid",
         action="store_true",
         help="write rows at poses too close to a singularity or outside a stroke limit as NaN "
-        "instead of refusing the trajectory",
+        "instead of refusing the trajectory (default: refuse)",
     )
 
     paper = sub.add_parser("paper", help="run the paper's two examples: CSV and figures")
-    paper.add_argument("--out", default="results", metavar="DIR", help="default: ./results")
-    paper.add_argument("--backend", choices=BACKENDS, default="numpy")
+    paper.add_argument(
+        "--out", default="results", metavar="DIR", help="output folder (default: ./results)"
+    )
+    paper.add_argument(
+        "--backend",
+        choices=BACKENDS,
+        default="numpy",
+        help="evaluate the generated NumPy or C code (default: numpy)",
+    )
 
     par = sub.add_parser(
         "params", help="print a model's parameter vector as 'name value' lines (for C users)"
     )
-    par.add_argument("--model", metavar="FILE", help="model TOML file (default: the paper's)")
+    par.add_argument("--model", metavar="FILE", help=f"model TOML file ({paper_model})")
 
     gen = sub.add_parser("generate", help="derive and write the generated sources")
-    gen.add_argument("--model", metavar="FILE", help="generate only this model's actuation")
-    gen.add_argument("--out", metavar="DIR", help="default: the source tree's generated/")
     gen.add_argument(
-        "--check", action="store_true", help="write nothing; fail if the sources are stale"
+        "--model",
+        metavar="FILE",
+        help="generate only this model's actuation (default: both actuations)",
+    )
+    gen.add_argument(
+        "--out", metavar="DIR", help="output folder (default: the source tree's generated/)"
+    )
+    gen.add_argument(
+        "--check",
+        action="store_true",
+        help="write nothing; fail if the sources are stale (default: write them)",
     )
     return parser
 
 
 def _trajectory(args: argparse.Namespace) -> tuple[str, Trajectory]:
+    given = {"samples": args.samples, "duration": args.duration}
+    timing = {key: value for key, value in given.items() if value is not None}
     if args.trajectory in PAPER_TRAJECTORIES:
-        return args.trajectory, paper_trajectory(args.trajectory, args.samples, args.duration)
+        if args.smoothing is not None:
+            raise TrajectoryError(
+                "--smoothing: only for a trajectory CSV file of positions; "
+                f"{args.trajectory!r} has analytic derivatives"
+            )
+        return args.trajectory, paper_trajectory(args.trajectory, **timing)
     path = Path(args.trajectory)
     if path.suffix.lower() != ".csv" and not path.exists():
         names = ", ".join(PAPER_TRAJECTORIES)
-        raise Rpr3genError(f"--trajectory: {args.trajectory!r} is neither {names} nor a CSV file")
-    return path.stem, read_trajectory_csv(path)
+        hint = did_you_mean(args.trajectory, PAPER_TRAJECTORIES)
+        raise TrajectoryError(
+            f"--trajectory: {args.trajectory!r} is neither {names} nor a CSV file{hint}"
+        )
+    if timing:
+        options = " and ".join(f"--{key}" for key in timing)
+        raise TrajectoryError(f"{options}: only for a paper trajectory; {path} has its own times")
+    return path.stem, read_trajectory_csv(path, smoothing=args.smoothing)
 
 
 def _screen(
@@ -104,12 +200,16 @@ def _screen(
     out: dict[str, np.ndarray],
     min_conditioning: float,
     allow_invalid: bool,
-) -> None:
-    """Refuse a trajectory through an invalid pose, or blank those rows when allowed."""
+) -> Invalid | None:
+    """Refuse a trajectory through an invalid pose, or blank those rows when allowed.
+
+    Returns:
+        The samples blanked (written as NaN), or None when every sample is valid.
+    """
     thresholds = manifest.load(model.actuation, model.generated).thresholds
     invalid = invalid_samples(model, traj.q, out, min_conditioning, thresholds)
     if invalid is None:
-        return
+        return None
     if not allow_invalid:
         k = invalid.first
         raise Rpr3genError(
@@ -119,6 +219,69 @@ def _screen(
     for name in OUTPUT_NAMES:
         if name != "conditioning":
             out[name] = np.where(invalid.mask, np.nan, out[name])
+    return invalid
+
+
+def _spans(t: np.ndarray, mask: np.ndarray, most: int = 3) -> str:
+    """When ``mask`` holds, e.g. ``"t = 0.2 s, 1.17 to 3 s"``: its runs, the first ``most``."""
+    edges = np.flatnonzero(np.diff(np.concatenate([[0], mask.astype(np.int8), [0]])))
+    runs = list(zip(edges[::2], edges[1::2] - 1, strict=True))  # first and last sample of each
+    parts = [f"{t[a]:.6g} s" if a == b else f"{t[a]:.6g} to {t[b]:.6g} s" for a, b in runs[:most]]
+    more = f" and {len(runs) - most} more spans" if len(runs) > most else ""
+    return "t = " + ", ".join(parts) + more
+
+
+def _refused(traj: Trajectory, invalid: Invalid) -> str:
+    """One line: how many samples were refused, when, and why the first one was."""
+    count = int(np.count_nonzero(invalid.mask))
+    return (
+        f"{count} of {len(traj.t)} samples refused and written as NaN, "
+        f"{_spans(traj.t, invalid.mask)} (first: {invalid.reason})"
+    )
+
+
+def _warn(message: str) -> None:
+    print(f"rpr3gen: warning: {message}", file=sys.stderr)
+
+
+@contextlib.contextmanager
+def _warnings_as_lines() -> Iterator[None]:
+    """Show the package's warnings as one line each, ``rpr3gen: warning: <msg>``, every time."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("always", Rpr3genWarning)
+        show = warnings.showwarning
+
+        def show_ours(
+            message: Warning | str,
+            category: type[Warning],
+            filename: str,
+            lineno: int,
+            file: TextIO | None = None,
+            line: str | None = None,
+        ) -> None:
+            if issubclass(category, Rpr3genWarning):
+                _warn(str(message))
+            else:
+                show(message, category, filename, lineno, file, line)
+
+        warnings.showwarning = show_ours
+        yield
+
+
+def _check_destination(path: Path, what: str, *, folder: bool) -> None:
+    """Refuse, before any work, an output path that an existing file or folder stands in the way of.
+
+    ``path`` is the file (``folder=False``) or the folder to be written; folders missing on the
+    way are created later.
+    """
+    if not folder and path.is_dir():
+        raise Rpr3genError(f"{path}: cannot write {what}: it is a folder")
+    for part in (path, *path.parents) if folder else path.parents:
+        if part.exists():
+            if not part.is_dir():
+                it = "it" if part == path else str(part)
+                raise Rpr3genError(f"{path}: cannot write {what}: {it} is a file, not a folder")
+            return
 
 
 def simulate(
@@ -130,17 +293,25 @@ def simulate(
     plots_dir: str | None,
     min_conditioning: float = DEFAULT_MIN_CONDITIONING,
     allow_invalid: bool = False,
-) -> dict[str, np.ndarray]:
+) -> tuple[dict[str, np.ndarray], Invalid | None]:
     """Evaluate, screen, and write the CSV and figures of one trajectory.
 
     Nothing is written unless the whole trajectory is valid (or ``allow_invalid``).
+
+    Returns:
+        Every output by name, shape ``(n,)``, and the samples refused (their outputs, but
+        ``conditioning``, are NaN; None when there are none, always unless ``allow_invalid``).
     """
     from rpr3gen.atomic import write_results_csv
 
-    if not min_conditioning >= 0.0:
-        raise Rpr3genError(f"--min-conditioning must be >= 0, got {min_conditioning}")
+    if not 0.0 <= min_conditioning < 1.0:
+        raise InputError(f"min_conditioning: must be in [0, 1), got {min_conditioning!r}")
+    if out_csv:
+        _check_destination(Path(out_csv), "the CSV", folder=False)
+    if plots_dir:
+        _check_destination(Path(plots_dir), "the figures", folder=True)
     out = inverse_dynamics(model, traj.q, traj.qd, traj.qdd, backend=backend, progress=True)
-    _screen(model, traj, out, min_conditioning, allow_invalid)
+    invalid = _screen(model, traj, out, min_conditioning, allow_invalid)
     if out_csv:
         Path(out_csv).parent.mkdir(parents=True, exist_ok=True)
         write_results_csv(out_csv, traj.t, traj.q, out, OUTPUT_NAMES)
@@ -155,11 +326,21 @@ def simulate(
             title=f"{name} ({model.name})",
             actuation=model.actuation,
         )
-    return out
+    return out, invalid
 
 
-def _summary(name: str, model: Model, traj: Trajectory, out: dict[str, np.ndarray]) -> str:
-    lines = [f"{name}: {len(traj.t)} samples over {traj.t[-1] - traj.t[0]:g} s, model {model.name}"]
+def _summary(
+    name: str,
+    model: Model,
+    traj: Trajectory,
+    out: dict[str, np.ndarray],
+    invalid: Invalid | None = None,
+) -> str:
+    n = len(traj.t)
+    lines = [f"{name}: {n} samples over {traj.t[-1] - traj.t[0]:g} s, model {model.name}"]
+    if invalid is not None:
+        valid = n - int(np.count_nonzero(invalid.mask))
+        lines.append(f"  {_refused(traj, invalid)}; the peaks are of the {valid} others")
     lines.append(f"  {'peak |value|':<12} {'leg A':>12} {'leg B':>12} {'leg C':>12}")
     for family in ("m10", "f21z", "f10x", "f10y", "f21y", "m21", "f32y", "f32z"):
         peaks = [float(np.nanmax(np.abs(out[f"{family}_{leg}"]), initial=0.0)) for leg in "ABC"]
@@ -170,7 +351,7 @@ def _summary(name: str, model: Model, traj: Trajectory, out: dict[str, np.ndarra
 def _cmd_simulate(args: argparse.Namespace) -> int:
     model = load_model(args.model)
     name, traj = _trajectory(args)
-    out = simulate(
+    out, invalid = simulate(
         model,
         name,
         traj,
@@ -180,19 +361,23 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
         min_conditioning=args.min_conditioning,
         allow_invalid=args.allow_invalid,
     )
-    print(_summary(name, model, traj, out))
+    if invalid is not None:
+        _warn(f"{name}: {_refused(traj, invalid)}")
+    print(_summary(name, model, traj, out, invalid))
     return 0
 
 
 def _cmd_paper(args: argparse.Namespace) -> int:
     model = load_model()
     root = Path(args.out)
+    summaries = []  # printed once every file is written, so a closed stdout stops nothing
     for name in PAPER_TRAJECTORIES:
         traj = paper_trajectory(name)
-        out = simulate(
+        out, _ = simulate(
             model, name, traj, args.backend, str(root / f"{name}.csv"), str(root / "figures")
         )
-        print(_summary(name, model, traj, out))
+        summaries.append(_summary(name, model, traj, out))
+    print("\n".join(summaries))
     print(f"wrote {root / '*.csv'} and {root / 'figures'}/*.png")
     return 0
 
@@ -236,7 +421,11 @@ def _cmd_generate(args: argparse.Namespace) -> int:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``rpr3gen`` command; returns the exit status."""
-    args = _parser().parse_args(argv)
+    parser = _parser()
+    args = parser.parse_args(argv)
+    if args.command is None:  # a bare `rpr3gen`: show what it can do
+        parser.print_help(sys.stderr)
+        return EXIT_ERROR
     commands = {
         "simulate": _cmd_simulate,
         "paper": _cmd_paper,
@@ -244,7 +433,12 @@ def main(argv: Sequence[str] | None = None) -> int:
         "generate": _cmd_generate,
     }
     try:
-        return commands[args.command](args)
+        with _warnings_as_lines():
+            status = commands[args.command](args)
+        sys.stdout.flush()  # a reader that went away shows here, not at the interpreter's exit
+        return status
+    except BrokenPipeError:
+        return _reader_went_away()
     except (Rpr3genError, OSError) as exc:
         if args.debug:
             raise
@@ -254,6 +448,21 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("rpr3gen: interrupted", file=sys.stderr)
         return 130
+
+
+def _reader_went_away() -> int:
+    """``rpr3gen ... | head -1``: the reader of stdout closed the pipe; stop quietly, status 0.
+
+    Every output file is complete by then (stdout gets only the summary, printed last); what
+    is lost is the text that the reader chose not to read.
+    """
+    # Python flushes stdout once more at exit and would report the pipe again: send the rest
+    # of the buffer to /dev/null instead.
+    with contextlib.suppress(OSError, ValueError):
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        os.close(devnull)
+    return 0
 
 
 def _os_message(exc: OSError) -> str:

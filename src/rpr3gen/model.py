@@ -13,7 +13,6 @@ names the file and the dotted key, e.g. ``my.toml: geometry.l0: must be a positi
 from __future__ import annotations
 
 import dataclasses
-import difflib
 import importlib.resources
 import json
 import math
@@ -28,7 +27,7 @@ from typing import Any, NoReturn
 import numpy as np
 
 from rpr3gen import manifest
-from rpr3gen.errors import ModelError, Rpr3genError
+from rpr3gen.errors import ModelError, Rpr3genError, did_you_mean
 
 __all__ = ["ACTUATIONS", "LEGS", "PARAM_NAMES", "Model", "load_model", "model_from_dict"]
 
@@ -227,7 +226,7 @@ class _Reader:
             self.fail("name", f"must be a non-empty string, got {_describe(name)}")
         actuation = self.required(data, "actuation", "actuation")
         if actuation not in ACTUATIONS:
-            hint = _suggest(actuation, ACTUATIONS) if isinstance(actuation, str) else ""
+            hint = did_you_mean(actuation, ACTUATIONS) if isinstance(actuation, str) else ""
             self.fail(
                 "actuation",
                 f"must be one of {_quoted(ACTUATIONS)}, got {_describe(actuation)}{hint}",
@@ -269,7 +268,7 @@ class _Reader:
         for key in table:
             dotted = f"{prefix}{key}"
             if key not in schema:
-                hint = _suggest(str(key), list(schema)) or self.elsewhere(str(key), prefix)
+                hint = did_you_mean(str(key), schema) or self.elsewhere(str(key), prefix)
                 self.fail(dotted, f"unknown key{hint}")
             sub = schema[key]
             if isinstance(sub, dict):
@@ -480,11 +479,6 @@ def _describe(value: Any) -> str:
     if isinstance(value, Real):
         return repr(int(value)) if isinstance(value, int | np.integer) else repr(float(value))
     return f"a value of type {type(value).__name__}"
-
-
-def _suggest(word: str, choices: Sequence[str]) -> str:
-    match = difflib.get_close_matches(word, choices, n=1, cutoff=0.6)
-    return f"; did you mean '{match[0]}'?" if match else ""
 
 
 def _quoted(words: Sequence[str]) -> str:

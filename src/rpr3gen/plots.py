@@ -1,5 +1,9 @@
 """The paper's figures: one PNG per output family, the three legs A, B, C in each.
 
+Each leg has its own line style, width and hollow marker, the markers at staggered samples, so
+legs whose curves coincide (as phi10 and lambda21 do in the paper's rotation) all stay visible;
+the title then says which legs coincide.
+
 Figures are drawn on :class:`matplotlib.figure.Figure` with the Agg canvas directly, never
 through ``pyplot``, so no global matplotlib state (backend, open figures) is touched. Size,
 resolution and PNG metadata are fixed, so the same data give the same files.
@@ -8,24 +12,52 @@ resolution and PNG metadata are fixed, so the same data give the same files.
 from __future__ import annotations
 
 import os
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from types import MappingProxyType
+from typing import Any
 
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from rpr3gen.atomic import atomic_write
+from rpr3gen.errors import InputError
 from rpr3gen.model import ACTUATIONS, LEGS
 
-__all__ = ["DPI", "FIGSIZE", "FamilyPlot", "plot_families", "plotted_families"]
+__all__ = [
+    "DPI",
+    "FIGSIZE",
+    "LEG_STYLES",
+    "FamilyPlot",
+    "coinciding_legs",
+    "family_figure",
+    "plot_families",
+    "plotted_families",
+]
 
 DPI = 120
 """Resolution of the PNG files, dots per inch."""
 
 FIGSIZE = (6.4, 4.0)
 """Figure size, inches (768 x 480 pixels at :data:`DPI`)."""
+
+LEG_STYLES: Mapping[str, Mapping[str, Any]] = MappingProxyType(
+    {
+        "A": {"linestyle": "-", "linewidth": 3.0, "marker": "o", "markersize": 8},
+        "B": {"linestyle": "--", "linewidth": 2.0, "marker": "s", "markersize": 6},
+        "C": {"linestyle": ":", "linewidth": 1.5, "marker": "^", "markersize": 5},
+    }
+)
+"""Line and marker of each leg: drawn in this order, wide to narrow, with hollow markers at
+staggered samples, so that legs whose curves coincide all stay visible."""
+
+MARKERS_PER_CURVE = 12
+"""About how many markers each curve carries."""
+
+COINCIDE_RTOL = 1e-9
+"""Two legs' curves coincide when they differ by at most this times the family's peak value."""
 
 
 @dataclass(frozen=True)
@@ -86,10 +118,10 @@ def plotted_families(actuation: str) -> tuple[FamilyPlot, ...]:
     """The families :func:`plot_families` draws for a robot with the given actuation, in order.
 
     Raises:
-        ValueError: If ``actuation`` is not ``"revolute"`` or ``"prismatic"``.
+        InputError: If ``actuation`` is not ``"revolute"`` or ``"prismatic"``.
     """
     if actuation not in ACTUATIONS:
-        raise ValueError(f"actuation must be one of {ACTUATIONS}, got {actuation!r}")
+        raise InputError(f"actuation must be one of {ACTUATIONS}, got {actuation!r}")
     return (*_PAPER_FAMILIES, _ACTUATOR[actuation], *_LEG_VARIABLES)
 
 
@@ -120,22 +152,22 @@ def plot_families(
         The paths written, in the order of :func:`plotted_families`.
 
     Raises:
-        ValueError: If ``actuation`` is unknown, an output is missing or a shape is wrong.
+        InputError: If ``actuation`` is unknown, an output is missing or a shape is wrong.
         OSError: If a folder or file cannot be written.
     """
     t = np.asarray(t, dtype=np.float64)
     if t.ndim != 1:
-        raise ValueError(f"t must have shape (n,), got {t.shape}")
+        raise InputError(f"t must have shape (n,), got {t.shape}")
     families = plotted_families(actuation)
     curves: dict[str, np.ndarray] = {}
     for spec in families:
         for leg in LEGS:
             key = f"{spec.family}_{leg}"
             if key not in outputs:
-                raise ValueError(f"no output named {key!r} to plot")
+                raise InputError(f"no output named {key!r} to plot")
             y = np.asarray(outputs[key], dtype=np.float64)
             if y.shape not in (t.shape, ()):
-                raise ValueError(f"output {key!r} must have shape {t.shape}, got {y.shape}")
+                raise InputError(f"output {key!r} must have shape {t.shape}, got {y.shape}")
             curves[key] = np.broadcast_to(y, t.shape)
 
     folder = Path(outdir)
@@ -143,22 +175,80 @@ def plot_families(
     written = []
     for spec in families:
         path = folder / f"{prefix}_{spec.family}.png"
-        fig = _figure(t, [curves[f"{spec.family}_{leg}"] for leg in LEGS], spec, title)
+        fig = family_figure(t, [curves[f"{spec.family}_{leg}"] for leg in LEGS], spec, title)
         with atomic_write(path, "wb") as f:
             fig.savefig(f, format="png", dpi=DPI, metadata={"Software": None})
         written.append(path)
     return written
 
 
-def _figure(t: np.ndarray, legs: list[np.ndarray], spec: FamilyPlot, title: str) -> Figure:
+def coinciding_legs(curves: Sequence[np.ndarray]) -> tuple[tuple[str, ...], ...]:
+    """Groups of two or more legs whose curves coincide, e.g. ``(("A", "B", "C"),)``.
+
+    Curves coincide when they differ nowhere by more than :data:`COINCIDE_RTOL` times the
+    largest magnitude of all of them (NaN where they are both NaN); all-zero curves coincide.
+
+    Args:
+        curves: One curve per leg A, B, C, each of shape ``(n,)``.
+    """
+    with np.errstate(invalid="ignore"):
+        peak = max((float(np.nanmax(np.abs(y), initial=0.0)) for y in curves), default=0.0)
+    tolerance = COINCIDE_RTOL * peak
+    groups: list[tuple[str, ...]] = []
+    placed: set[int] = set()
+    for i in range(len(curves)):
+        if i in placed:
+            continue
+        group = [i] + [
+            j
+            for j in range(i + 1, len(curves))
+            if j not in placed
+            and np.allclose(curves[i], curves[j], rtol=0.0, atol=tolerance, equal_nan=True)
+        ]
+        placed.update(group)
+        if len(group) > 1:
+            groups.append(tuple(LEGS[k] for k in group))
+    return tuple(groups)
+
+
+def _coincide_note(groups: tuple[tuple[str, ...], ...]) -> str:
+    """``"legs A, B and C coincide"``; groups joined by ``"; "``."""
+    return "; ".join(f"legs {', '.join(group[:-1])} and {group[-1]} coincide" for group in groups)
+
+
+def family_figure(
+    t: np.ndarray, legs: Sequence[np.ndarray], spec: FamilyPlot, title: str
+) -> Figure:
+    """The figure of one family: the legs A, B, C against time, in :data:`LEG_STYLES`.
+
+    When legs coincide (:func:`coinciding_legs`), a second title line says which.
+
+    Args:
+        t: Sample times, s, shape ``(n,)``.
+        legs: The family's curve for each leg A, B, C, each of shape ``(n,)``.
+        spec: How the family is named and labelled.
+        title: Appended to the title after a dash.
+    """
     fig = Figure(figsize=FIGSIZE, dpi=DPI, layout="constrained")
     FigureCanvasAgg(fig)
     ax = fig.add_subplot()
-    for leg, y in zip(LEGS, legs, strict=True):
-        ax.plot(t, y, label=f"leg {leg}")
+    step = max(1, len(t) // MARKERS_PER_CURVE)
+    for k, (leg, y) in enumerate(zip(LEGS, legs, strict=True)):
+        ax.plot(
+            t,
+            y,
+            label=f"leg {leg}",
+            markevery=(k * step // len(LEGS), step),  # staggered: markers never overlap
+            markerfacecolor="none",
+            **LEG_STYLES[leg],
+        )
     ax.set_xlabel("time t [s]")
     ax.set_ylabel(f"{spec.symbol} [{spec.unit}]")
-    ax.set_title(spec.title(title))
+    heading = spec.title(title)
+    groups = coinciding_legs(legs)
+    if groups:
+        heading += f"\n({_coincide_note(groups)})"
+    ax.set_title(heading)
     ax.grid(True, alpha=0.3)
     ax.legend()
     return fig

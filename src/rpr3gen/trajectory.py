@@ -4,7 +4,9 @@ A trajectory samples the platform pose ``q = (x, y, phi)`` (position of G in the
 and the platform's rotation from the central configuration, rad) with its first and second time
 derivatives. The CSV layout is fixed by ``docs/interfaces.md``: a header naming the columns
 ``t,x,y,phi,dx,dy,dphi,ddx,ddy,ddphi`` (any order, extra columns ignored), then one row per
-sample with time strictly increasing.
+sample with time strictly increasing. A file may also give the positions alone, ``t,x,y,phi``:
+the velocities and accelerations are then those of a quintic smoothing spline through them, and
+a file that gives them is checked against its positions (:mod:`rpr3gen.derivatives`).
 """
 
 from __future__ import annotations
@@ -13,6 +15,7 @@ import csv
 import difflib
 import math
 import os
+import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass
 from types import MappingProxyType
@@ -21,11 +24,15 @@ from typing import TextIO
 import numpy as np
 
 from rpr3gen.atomic import write_csv_table
-from rpr3gen.errors import TrajectoryError
+from rpr3gen.derivatives import check_smoothing, differentiate, mismatch
+from rpr3gen.errors import InputTypeError, TrajectoryError, TrajectoryWarning, did_you_mean
 
 __all__ = [
     "CSV_COLUMNS",
+    "DEFAULT_DURATION",
+    "DEFAULT_SAMPLES",
     "PAPER_TRAJECTORIES",
+    "POSITION_COLUMNS",
     "Trajectory",
     "paper_trajectory",
     "read_trajectory_csv",
@@ -35,6 +42,9 @@ __all__ = [
 CSV_COLUMNS: tuple[str, ...] = ("t", "x", "y", "phi", "dx", "dy", "dphi", "ddx", "ddy", "ddphi")
 """Columns of a trajectory CSV file, in the order :func:`write_trajectory_csv` writes them."""
 
+POSITION_COLUMNS: tuple[str, ...] = CSV_COLUMNS[:4]
+"""Columns of a file of positions only, whose derivatives :func:`read_trajectory_csv` derives."""
+
 PAPER_TRAJECTORIES: Mapping[str, tuple[float, float, float]] = MappingProxyType(
     {
         "rotation": (0.0, 0.0, math.pi / 6),  # figures 3-8
@@ -42,6 +52,12 @@ PAPER_TRAJECTORIES: Mapping[str, tuple[float, float, float]] = MappingProxyType(
     }
 )
 """Amplitudes ``(x*, y*, phi*)`` (m, m, rad) of the paper's motions, eq. (3)."""
+
+DEFAULT_SAMPLES = 301
+"""Samples of a paper trajectory unless told otherwise (one every 10 ms over the 3 s)."""
+
+DEFAULT_DURATION = 3.0
+"""Duration of the paper's motions, s (Δt of eq. 3)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -77,8 +93,40 @@ class Trajectory:
         """Number of samples."""
         return int(self.t.size)
 
+    @classmethod
+    def from_positions(
+        cls, t: np.ndarray, q: np.ndarray, smoothing: float = 0.0, *, source: str = "positions"
+    ) -> Trajectory:
+        """The motion through the poses ``q``, with the derivatives of a quintic spline.
 
-def paper_trajectory(name: str, samples: int = 301, duration: float = 3.0) -> Trajectory:
+        Velocities and accelerations are the first and second derivatives of a quintic
+        smoothing spline per coordinate (:func:`rpr3gen.derivatives.differentiate`).
+
+        Args:
+            t: Sample times, s, finite and strictly increasing, shape ``(n,)``, ``n >= 6``.
+            q: Poses ``(x, y, phi)`` (m, m, rad), finite, shape ``(n, 3)``.
+            smoothing: RMS deviation allowed between the spline and ``q`` (m for x and y, rad
+                for phi). 0 (the default) passes through every pose, which then stay as given;
+                for measured poses give their noise level.
+            source: Where the poses come from, for messages.
+
+        Raises:
+            TrajectoryError: For a bad shape, a value not finite, time not strictly increasing
+                or fewer than 6 samples.
+            InputTypeError, InputError: For a ``smoothing`` that is not a number >= 0.
+        """
+        given = cls(t=t, q=q, qd=q, qdd=q)  # shapes checked, float64 copies
+        if not (np.isfinite(given.t).all() and np.isfinite(given.q).all()):
+            raise TrajectoryError(f"{source}: t and q must be finite")
+        if np.any(np.diff(given.t) <= 0):
+            raise TrajectoryError(f"{source}: time must be strictly increasing")
+        q_fit, qd, qdd = differentiate(given.t, given.q, smoothing, source=source)
+        return cls(t=given.t, q=q_fit, qd=qd, qdd=qdd)
+
+
+def paper_trajectory(
+    name: str, samples: int = DEFAULT_SAMPLES, duration: float = DEFAULT_DURATION
+) -> Trajectory:
     """Sample one of the paper's motions, eq. (3).
 
     ``x/x* = y/y* = phi/phi* = 1 - cos(pi t / duration)`` for ``t`` in ``[0, duration]``: the
@@ -90,21 +138,23 @@ def paper_trajectory(name: str, samples: int = 301, duration: float = 3.0) -> Tr
         duration: Length of the motion, s, finite and positive (the paper: 3 s).
 
     Raises:
-        TrajectoryError: For an unknown name or a bad ``samples`` or ``duration``.
+        TrajectoryError: For an unknown name, ``samples < 2`` or a ``duration`` not finite and
+            positive.
+        InputTypeError: If ``samples`` is not an integer or ``duration`` not a number.
     """
     if name not in PAPER_TRAJECTORIES:
-        match = difflib.get_close_matches(str(name), list(PAPER_TRAJECTORIES), n=1)
-        hint = f"; did you mean '{match[0]}'?" if match else ""
+        hint = did_you_mean(str(name), PAPER_TRAJECTORIES)
         choices = " or ".join(PAPER_TRAJECTORIES)
         raise TrajectoryError(f"unknown trajectory {name!r}: choose {choices}{hint}")
-    if isinstance(samples, bool) or not isinstance(samples, int | np.integer) or samples < 2:
+    if isinstance(samples, bool) or not isinstance(samples, int | np.integer):
+        raise InputTypeError(f"samples: must be an integer >= 2, got {samples!r}")
+    if samples < 2:
         raise TrajectoryError(f"samples: must be an integer >= 2, got {samples!r}")
-    if (
-        isinstance(duration, bool)
-        or not isinstance(duration, int | float | np.integer | np.floating)
-        or not math.isfinite(duration)
-        or duration <= 0
+    if isinstance(duration, bool) or not isinstance(
+        duration, int | float | np.integer | np.floating
     ):
+        raise InputTypeError(f"duration: must be a finite number of seconds > 0, got {duration!r}")
+    if not math.isfinite(duration) or duration <= 0:
         raise TrajectoryError(f"duration: must be a finite number of seconds > 0, got {duration!r}")
 
     amplitude = np.array(PAPER_TRAJECTORIES[name], dtype=np.float64)
@@ -121,21 +171,42 @@ def paper_trajectory(name: str, samples: int = 301, duration: float = 3.0) -> Tr
     )
 
 
-def read_trajectory_csv(path: str | os.PathLike[str]) -> Trajectory:
+def read_trajectory_csv(
+    path: str | os.PathLike[str], *, smoothing: float | None = None
+) -> Trajectory:
     """Read a trajectory CSV file (layout in the module docstring).
 
     Blank lines are skipped. Errors name the file, the line number in the file (the first
     line is line 1), the 1-based data row (blank lines not counted) and the column.
 
+    A file with the columns ``t,x,y,phi`` and none of the derivatives gives the positions only:
+    velocities and accelerations are derived as in :meth:`Trajectory.from_positions`. A file
+    that gives them is checked against its positions (:func:`rpr3gen.derivatives.mismatch`)
+    and used as given.
+
+    Args:
+        path: The CSV file.
+        smoothing: For a file of positions only: the RMS deviation allowed between the fitted
+            spline and the positions (m for x and y, rad for phi); None or 0 passes through
+            every sample. An error with a file that gives the derivatives.
+
     Raises:
         TrajectoryError: If the file cannot be read, a column is missing, a value is not a
-            finite number, a row is short or long, there are no data rows, or time is not
-            strictly increasing.
+            finite number, a row is short or long, there are no data rows, time is not
+            strictly increasing, a file of positions only has fewer than 6 rows, or
+            ``smoothing`` is given for a file with derivatives.
+        InputTypeError, InputError: For a ``smoothing`` that is not a number >= 0.
+
+    Warns:
+        TrajectoryWarning: If the file's velocities or accelerations disagree with its
+            positions (a ``UserWarning``; the command prints it as one line).
     """
     source = os.fspath(path)
+    if smoothing is not None:
+        smoothing = check_smoothing(smoothing)
     try:
         with open(source, encoding="utf-8-sig", newline="") as f:
-            return _parse(f, source)
+            data = _parse(f, source)
     except FileNotFoundError:
         raise TrajectoryError(f"{source}: trajectory file not found") from None
     except IsADirectoryError:
@@ -147,9 +218,23 @@ def read_trajectory_csv(path: str | os.PathLike[str]) -> Trajectory:
         raise TrajectoryError(f"{source}: malformed CSV: {exc}") from None
     except OSError as exc:
         raise TrajectoryError(f"{source}: cannot read: {exc.strerror or exc}") from None
+    t, q = data[:, 0], data[:, 1:4]
+    if data.shape[1] == len(POSITION_COLUMNS):
+        return Trajectory.from_positions(t, q, smoothing or 0.0, source=source)
+    if smoothing is not None:
+        raise TrajectoryError(
+            f"{source}: smoothing is for a file of positions only (t,x,y,phi); this one gives "
+            "the velocities and accelerations"
+        )
+    traj = Trajectory(t=t, q=q, qd=data[:, 4:7], qdd=data[:, 7:10])
+    problem = mismatch(traj.t, traj.q, traj.qd, traj.qdd)
+    if problem:
+        warnings.warn(f"{source}: {problem}", TrajectoryWarning, stacklevel=2)
+    return traj
 
 
-def _parse(f: TextIO, source: str) -> Trajectory:
+def _parse(f: TextIO, source: str) -> np.ndarray:
+    """The table of a trajectory file: columns :data:`CSV_COLUMNS` or :data:`POSITION_COLUMNS`."""
     reader = csv.reader(f)
     header: list[str] | None = None
     for row in reader:
@@ -167,7 +252,10 @@ def _parse(f: TextIO, source: str) -> Trajectory:
                 f"{source}: line {header_line} (header): column {name!r} appears twice"
             )
         index.setdefault(name, i)
-    for name in CSV_COLUMNS:
+    # Positions alone, or everything: a file with some of the derivatives lacks the others.
+    given = any(name in index for name in CSV_COLUMNS[len(POSITION_COLUMNS) :])
+    columns = CSV_COLUMNS if given else POSITION_COLUMNS
+    for name in columns:
         if name not in index:
             others = [h for h in header if h not in CSV_COLUMNS]
             match = difflib.get_close_matches(name, others, n=1)
@@ -175,7 +263,7 @@ def _parse(f: TextIO, source: str) -> Trajectory:
             raise TrajectoryError(
                 f"{source}: line {header_line} (header): missing column {name!r}{hint}"
             )
-    wanted = [index[name] for name in CSV_COLUMNS]
+    wanted = [index[name] for name in columns]
 
     values: list[list[float]] = []
     for row in reader:
@@ -185,7 +273,7 @@ def _parse(f: TextIO, source: str) -> Trajectory:
         if len(row) != len(header):
             raise TrajectoryError(f"{where}: has {len(row)} fields, the header has {len(header)}")
         numbers = []
-        for name, col in zip(CSV_COLUMNS, wanted, strict=True):
+        for name, col in zip(columns, wanted, strict=True):
             cell = row[col].strip()
             try:
                 x = float(cell)
@@ -203,8 +291,7 @@ def _parse(f: TextIO, source: str) -> Trajectory:
     if not values:
         raise TrajectoryError(f"{source}: no data rows after the header")
 
-    data = np.array(values, dtype=np.float64)
-    return Trajectory(t=data[:, 0], q=data[:, 1:4], qd=data[:, 4:7], qdd=data[:, 7:10])
+    return np.array(values, dtype=np.float64)
 
 
 def write_trajectory_csv(path: str | os.PathLike[str], traj: Trajectory) -> None:
