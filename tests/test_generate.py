@@ -13,7 +13,10 @@ import pytest
 from rpr3gen_derive.codegen import files
 from rpr3gen_derive.rpr3 import generate
 
+import rpr3gen
+from rpr3gen import manifest
 from rpr3gen.cli import main
+from rpr3gen.evaluators import numpy_module
 
 
 def test_committed_generated_tree_is_current(
@@ -116,3 +119,33 @@ def test_source_hash_follows_the_sources(tmp_path: Path) -> None:
     frames = copy / "rpr3" / "frames.py"
     frames.write_text(frames.read_text() + "\n# edit\n")
     assert files.source_hash(roots) != original
+
+
+def test_a_generated_folder_is_used_by_simulate_and_the_api(tmp_path: Path) -> None:
+    out = tmp_path / "gen"
+    assert main(["generate", "--out", str(out)]) == 0
+    # Mark the copy so that using it is visible: a comment in its NumPy module changes nothing.
+    numpy_file = out / "revolute" / "rpr3_numpy.py"
+    numpy_file.write_text(numpy_file.read_text() + "\nUSED_FROM_THE_FOLDER = True\n")
+    model = rpr3gen.load_model(generated=out)
+    variant = manifest.load(model.actuation, model.generated)
+    assert variant.folder == (out / "revolute").resolve()
+    assert numpy_module(variant).USED_FROM_THE_FOLDER
+    traj = rpr3gen.paper_trajectory("rectilinear", samples=21)
+    mine = rpr3gen.inverse_dynamics(model, traj.q, traj.qd, traj.qdd)
+    installed = rpr3gen.inverse_dynamics(rpr3gen.load_model(), traj.q, traj.qd, traj.qdd)
+    for name in rpr3gen.OUTPUT_NAMES:
+        assert mine[name].tobytes() == installed[name].tobytes()
+    csv = tmp_path / "r.csv"
+    assert main(["simulate", "--generated", str(out), "--out", str(csv)]) == 0
+    assert csv.is_file()
+
+
+def test_a_missing_generated_folder_is_one_clear_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture
+) -> None:
+    assert main(["simulate", "--generated", str(tmp_path / "nothing")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1
+    assert "nothing" in err
+    assert "rpr3gen generate" in err

@@ -137,6 +137,12 @@ def _parser() -> argparse.ArgumentParser:
         help="write rows at poses too close to a singularity or outside a stroke limit as NaN "
         "instead of refusing the trajectory (default: refuse)",
     )
+    sim.add_argument(
+        "--generated",
+        metavar="DIR",
+        help="evaluate with the generated code in DIR, written by `rpr3gen generate --out DIR` "
+        "(default: the installed generated package)",
+    )
 
     paper = sub.add_parser("paper", help="run the paper's two examples: CSV and figures")
     paper.add_argument(
@@ -349,7 +355,7 @@ def _summary(
 
 
 def _cmd_simulate(args: argparse.Namespace) -> int:
-    model = load_model(args.model)
+    model = load_model(args.model, generated=args.generated)
     name, traj = _trajectory(args)
     out, invalid = simulate(
         model,
