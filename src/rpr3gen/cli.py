@@ -140,7 +140,7 @@ def _parser() -> argparse.ArgumentParser:
     sim.add_argument(
         "--generated",
         metavar="DIR",
-        help="evaluate with the generated code in DIR, written by `rpr3gen generate --out DIR` "
+        help="evaluate with the generated code that `rpr3gen generate` wrote into DIR "
         "(default: the installed generated package)",
     )
 
