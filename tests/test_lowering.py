@@ -1,4 +1,4 @@
-"""The NumPy lowering (derive/lowering.py) against SymPy's own evaluation, branch by branch."""
+"""The NumPy lowering (derive/codegen/backends/python/lowering.py) against SymPy, by branch."""
 
 from __future__ import annotations
 
