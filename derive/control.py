@@ -68,6 +68,12 @@ ACTUATORS: dict[str, Actuator] = {
 #: Most assembly modes for given actuator coordinates (interfaces.md, RPR3_MAX_MODES).
 MAX_MODES: dict[str, int] = {"revolute": 2, "prismatic": 6}
 
+#: A leg shorter than this times the platform's RMS radius has no length (not an assembly mode).
+LENGTH_TOL = 1e-9
+#: Revolute direct kinematics: legs within this angle (rad) of all parallel (``|k|``), or
+#: ``|(A, B)|`` below this times ``|k| rho``, are degenerate (round-off is ~1e-16 of either).
+DEGENERACY_TOL = 1e-10
+
 #: Upper triangle of the symmetric 3 x 3 mass matrix, row-major.
 UPPER: tuple[tuple[int, int], ...] = ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))
 
@@ -556,12 +562,19 @@ def assembly_modes_revolute(prog: Program) -> list[Mode]:
     ``G`` then solves the three (consistent) line equations in the least-squares sense,
     ``N^T N G = N^T (w - u cos - v sin)`` with ``det(N^T N) = |k|^2``.
 
-    A mode is valid when ``A^2 + B^2 >= C^2`` (real), every leg length ``(A3 - A1) . e_i`` is
-    positive, ``|k|^2 > 0`` (not all legs parallel, else G is not fixed) and ``A^2 + B^2 > 0``.
-    When ``A = B = 0`` the orientation is not fixed by the actuators: either no pose at all
-    (``C != 0``) or a continuum of them (``C = 0``, a self-motion); neither is an isolated mode,
-    so both are reported invalid. ``phi`` is in ``[-pi, pi]`` (``atan2``); the two modes coincide
-    where ``A^2 + B^2 = C^2`` (a parallel singularity). Units: m, m, rad.
+    A mode is valid when it is real (``A^2 + B^2 >= C^2``) and every leg length
+    ``(A3 - A1) . e_i`` exceeds ``LENGTH_TOL`` times the platform's RMS radius ``rho``: the
+    round-off of a zero length is not a mode (the paper's robot, whose base and platform triangles
+    are congruent, has every leg of zero length at ``G = 0, phi = -pi/3`` whatever ``qa``).
+
+    Degenerate inputs have no isolated mode, and both modes are reported invalid: all legs
+    parallel (``|k| <= DEGENERACY_TOL``: G is not fixed), or ``A = B = 0``
+    (``|(A, B)| <= DEGENERACY_TOL |k| rho``), where the actuators do not fix the orientation:
+    either no pose at all (``C != 0``) or a continuum of them (``C = 0``, a self-motion). The
+    round-off of a zero ``k``, ``A`` or ``B`` is about 1e-16 of these scales.
+
+    ``phi`` is in ``[-pi, pi]`` (``atan2``); the two modes coincide where ``A^2 + B^2 = C^2``
+    (a parallel singularity). Units: m, m, rad.
     """
     step = STEP_FK_REVOLUTE
     bld = _Builder(prog)
@@ -592,6 +605,7 @@ def assembly_modes_revolute(prog: Program) -> list[Mode]:
     s_sc = sum(n[leg][0] * n[leg][1] for leg in LEGS)
     ksq = bld.define("fk_ksq", sum(k[leg] ** 2 for leg in LEGS), step)
     inv_ksq = bld.define("fk_inv_ksq", 1 / ksq, step)
+    min_length = platform_rms_radius()
     modes = []
     for m, sign in ((1, 1), (2, -1)):
         cos_phi = bld.define(f"fk{m}_cos_phi", (-A * C - sign * B * root) * inv_ab2, step)
@@ -613,9 +627,9 @@ def assembly_modes_revolute(prog: Program) -> list[Mode]:
             lengths.append(bld.define(f"fk{m}_length_{leg}", _dot(e[leg], d), step))
         valid = sp.And(
             sp.GreaterThan(disc, 0),
-            sp.StrictGreaterThan(ab2, 0),
-            sp.StrictGreaterThan(ksq, 0),
-            *(sp.StrictGreaterThan(length, 0) for length in lengths),
+            sp.StrictGreaterThan(ab2, DEGENERACY_TOL**2 * ksq * platform_radius_squared()),
+            sp.StrictGreaterThan(ksq, DEGENERACY_TOL**2),
+            *(sp.StrictGreaterThan(length, LENGTH_TOL * min_length) for length in lengths),
         )
         modes.append(Mode(x, y, phi, valid))
     return modes

@@ -7,6 +7,7 @@ NumPy printer into the body of one Python function, which then evaluates them in
 
 from __future__ import annotations
 
+import importlib
 from collections.abc import Callable, Mapping, Sequence
 
 import numpy as np
@@ -53,8 +54,8 @@ def compile_program(
     namespace: dict = {"wrap_angle": _wrap_angle, "numpy": np}
     for module in sorted(printer.module_imports):
         for name in sorted(printer.module_imports[module]):
-            namespace[name] = getattr(np, name) if module == "numpy" else __import__(module)
-    exec("\n".join(lines), namespace)  # noqa: S102 (code printed by SymPy from the program)
+            namespace[name] = getattr(importlib.import_module(module), name)
+    exec("\n".join(lines), namespace)
     function = namespace["_program"]
 
     def evaluate(**values: object) -> list[np.ndarray]:
