@@ -23,6 +23,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cache
+from typing import NamedTuple
 
 import sympy as sp
 from rpr3gen_derive import symbols as syms
@@ -357,7 +358,9 @@ def _effort_affine(prog: Program, actuation: str) -> tuple[sp.Matrix, sp.Matrix]
     return A, b
 
 
-def _leg_wrench_components(prog: Program, derivation: Derivation) -> dict[str, tuple]:
+def _leg_wrench_components(
+    prog: Program, derivation: Derivation
+) -> dict[str, tuple[sp.Expr, sp.Expr]]:
     """Per leg, the moment about A1 (z0) and the axial force (e) that the leg's own two bodies
     require: ``M1_z`` and ``F2_z`` of the recursion (10)-(11) run without the platform.
 
@@ -442,16 +445,25 @@ def task_space_dynamics(
     """``M`` (3 x 3, symmetric positive definite) and ``c`` (3) with ``M q'' + c = J^T tau``.
 
     The loads of the virtual-work derivation (eqs. 10-17) are affine in the platform
-    acceleration, ``tau = A(q) q'' + b(q, q')``: ``A`` is found by differentiating the program
-    assignment by assignment (:func:`differentiate`) and ``b`` by setting ``q'' = 0``
-    (:func:`at_zero`). Then ``M = J^T A`` and ``c = J^T b`` (units: kg, kg m, kg m^2; N, N m).
+    acceleration, ``tau = A(q) q'' + b(q, q')``, so ``M = J^T A`` and ``c = J^T b`` (units: kg,
+    kg m, kg m^2; N, N m). Two routes, equal to round-off (tested):
 
-    ``method="efforts"`` does exactly that. ``method="virtual_power"`` (the default) applies
-    ``J^T`` before differentiating: ``J^T tau`` is written as the virtual power of the same
-    wrenches F_k, M_k in unit platform twists (:func:`_generalized_forces`), which is the loads
-    of eqs. (12)-(17) with ``J^T W^-1`` cancelled by hand (``W = -diag(L) J`` with revolute
-    actuation, ``diag(L) J`` with prismatic): the same numbers, with no closure matrix to invert,
-    and the same ``M``, ``c`` for both actuations. Only the upper triangle of ``M`` is named.
+    - ``method="efforts"``: exactly that. ``A`` by differentiating the program of
+      ``specs.derive`` assignment by assignment (:func:`differentiate`), ``b`` by setting
+      ``q'' = 0`` in it (:func:`at_zero`), then ``J^T A``, ``J^T b``. It carries the closure
+      solve of eq. (7) (``W^-1``, which ``J^T`` then undoes: ``W = -diag(L) J`` with revolute
+      actuation, ``diag(L) J`` with prismatic).
+    - ``method="virtual_power"`` (the default, about half the operations): ``J^T tau`` is the
+      virtual power of the same required wrenches (``dynamics.required_wrench`` and the
+      recursion 10-11 of each leg) in the unit platform twists, :func:`_virtual_powers`, so no
+      closure matrix is inverted; then the same differentiation and zeroing. ``M`` and ``c``
+      are those of the mechanism, the same for both actuations, and each leg adds a rank-one
+      term per joint: ``M = diag(m3, m3, J3) + sum_i (K_i J10_i^T J10_i + m2 J21_i^T J21_i)``
+      with ``K_i`` the inertia of cylinder and piston about A1.
+
+    ``M`` is positive definite wherever every leg has positive length, parallel singularities
+    included. Only its upper triangle is named (``M11 M12 M13 M22 M23 M33``); ``c`` is named
+    ``bias1..3``.
     """
     if method == "efforts":
         A, b = _effort_affine(prog, actuation)
@@ -510,10 +522,10 @@ def ldlt_solve(prog: Program, M: sp.Matrix, rhs: sp.Matrix, name: str, step: str
 def forward_dynamics(prog: Program, actuation: str) -> sp.Matrix:
     """``q'' = M^-1 (J^T tau - c)`` (3-vector), for the efforts :data:`tau`, by LDL^T.
 
-    ``J^T tau - c`` is formed as ``J^T tau - c`` with ``M``, ``c`` of :func:`task_space_dynamics`
-    (default method); the 3 x 3 solve is :func:`ldlt_solve` (M is symmetric positive definite
-    wherever the legs have positive length; the result is meaningless where ``J`` is singular,
-    which the caller refuses by the conditioning measure of ``virtual_work.conditioning``).
+    ``M``, ``c`` of :func:`task_space_dynamics` (default route) and the 3 x 3 solve of
+    :func:`ldlt_solve`. Nothing here divides by ``det J``: the forward dynamics is defined at a
+    parallel singularity too (the efforts just cannot push the platform along the singular
+    direction); only a leg of zero length is singular. Units: m/s^2, m/s^2, rad/s^2.
     """
     M, c = task_space_dynamics(prog, actuation)
     J = actuator_jacobian(prog, actuation)
@@ -539,9 +551,8 @@ def _dot(a: tuple[sp.Expr, sp.Expr], b: tuple[sp.Expr, sp.Expr]) -> sp.Expr:
     return a[0] * b[0] + a[1] * b[1]
 
 
-@dataclass(frozen=True)
-class Mode:
-    """One assembly mode: pose ``(x, y, phi)`` and whether it exists (a sympy Boolean)."""
+class Mode(NamedTuple):
+    """One assembly mode ``(x, y, phi, valid)``: the pose, and whether it exists (a Boolean)."""
 
     x: sp.Expr
     y: sp.Expr
@@ -739,7 +750,7 @@ def sextic_coefficients(prog: Program) -> list[sp.Expr]:
 
     ``a6 = F(pi)``: when ``phi = pi`` is a root the degree drops (the root is at ``t = inf``);
     the numeric drivers of ``fk_tracking`` look for it there. A root with ``D = 0`` needs the
-    fallback of :func:`pose_from_angle`. Units: m^6.
+    treatment described in :func:`pose_from_angle`. Units: m^6.
     """
     step = STEP_FK_PRISMATIC
     bld = _Builder(prog)
@@ -769,12 +780,14 @@ def pose_from_angle(prog: Program, cos_phi: sp.Expr, sin_phi: sp.Expr) -> tuple[
 
     ``u = (rho_C w_B^perp - rho_B w_C^perp) / D`` (see :func:`sextic_coefficients`), then
     ``G = A1_A + u - R(phi) p_A``. Singular where ``D = w_B x w_C = 0``: the two linear
-    equations for ``u`` are then parallel (or void). This function does not guard it; the numeric
-    driver (``fk_tracking.pose_candidates_prismatic``) tests ``|D|`` against
-    ``1e-9 |w_B| |w_C|`` and then intersects the line ``u . w_i = rho_i`` (the longer ``w_i``)
-    with the circle ``|u| = L_A`` instead (two candidates, each polished by Newton), or gives up
-    on this root when both ``w_i`` vanish (the platform's and the base's triangles are congruent
-    at this angle, a self-motion when the lengths agree). Units: m.
+    equations for ``u`` are then parallel, or void. That happens at a root where two modes share
+    one orientation (``F`` then has a double root there), or at a spurious root where both
+    ``w_i`` vanish (base and platform triangles congruent at this angle: the paper's robot at
+    ``phi = -pi/3``, a root of ``F`` for any lengths). This function does not guard it; the
+    numeric driver (``fk_tracking.pose_candidates``) tests
+    ``|D| <= PARALLEL_TOL |w_B| |w_C|`` and then intersects the line ``u . w_i = rho_i`` of the
+    longer ``w_i`` with the circle ``|u| = L_A`` (two candidates, each polished by Newton on the
+    original equations), or drops the root when both ``w_i`` vanish (no isolated mode). Units: m.
     """
     step = STEP_FK_PRISMATIC
     bld = _Builder(prog)
