@@ -83,27 +83,68 @@ def main() -> None:
         cells = ", ".join(f"{k}: {counter[k]}" for k in sorted(counter))
         print(f"| {actuation} | {cells} |")
 
-    print("\n| trajectory | actuation | mean Newton steps | max | fallbacks | max error (m) |")
-    print("|---|---|---|---|---|---|")
+    print(
+        "\n| trajectory | actuation | reference | mean Newton steps | max | fallbacks "
+        "| max error (m) |"
+    )
+    print("|---|---|---|---|---|---|---|")
     params = ne.paper_params()
     geom = fk.Geometry.from_params(params)
     for kind in ("rotation", "rectilinear"):
         _, q, _, _ = ne.paper_motion(kind, samples=3001)  # 1 ms
         for actuation in control.ACTUATIONS:
-            near = tuple(q[0])
-            steps, fallbacks, error = [], 0, 0.0
-            for k in range(len(q)):
-                qa = fk.actuator_coordinates(geom, actuation, q[k])
-                result = fk.tracked_forward_kinematics(geom, actuation, qa, near)
-                steps.append(result.iterations)
-                fallbacks += result.status != "newton"
-                error = max(error, fk.distance(geom, result.q, q[k]))
-                near = result.q
+            for reference in ("previous", "predicted"):
+                prev = prev2 = tuple(q[0])
+                steps, fallbacks, error = [], 0, 0.0
+                for k in range(len(q)):
+                    qa = fk.actuator_coordinates(geom, actuation, q[k])
+                    near = prev
+                    if reference == "predicted":
+                        near = tuple(2 * a - b for a, b in zip(prev, prev2, strict=True))
+                    result = fk.tracked_forward_kinematics(geom, actuation, qa, near)
+                    steps.append(result.iterations)
+                    fallbacks += result.status != "newton"
+                    error = max(error, fk.distance(geom, result.q, q[k]))
+                    prev2, prev = prev, result.q
+                print(
+                    f"| {kind} | {actuation} | {reference} | {np.mean(steps):.3f} | {max(steps)} "
+                    f"| {fallbacks} | {error:.1e} |"
+                )
+
+
+def random_motions() -> None:
+    """Tracking on ten random robots and motions (``newton_euler.random_case``), 2 s at 1 ms."""
+    print(
+        "\n| random motions, 1 ms | actuation | reference | mean Newton steps | max "
+        "| fallbacks | max error (m) | motions crossing det J = 0 |"
+    )
+    print("|---|---|---|---|---|---|---|---|")
+    t = np.arange(0.0, 2.0, 1e-3)
+    cases = [ne.random_case(seed, t) for seed in range(10)]
+    for actuation in control.ACTUATIONS:
+        for reference in ("previous", "predicted"):
+            steps, fallbacks, error, crossing = [], 0, 0.0, 0
+            for robot, q, _, _ in cases:
+                geom = fk.Geometry.from_params(robot["params"])
+                dets = [fk.det3(fk.actuator_jacobian(geom, actuation, row)) for row in q]
+                crossing += min(dets) < 0 < max(dets)
+                prev = prev2 = tuple(q[0])
+                for row in q:
+                    qa = fk.actuator_coordinates(geom, actuation, row)
+                    near = prev
+                    if reference == "predicted":
+                        near = tuple(2 * a - b for a, b in zip(prev, prev2, strict=True))
+                    result = fk.tracked_forward_kinematics(geom, actuation, qa, near)
+                    steps.append(result.iterations)
+                    fallbacks += result.status != "newton"
+                    error = max(error, fk.distance(geom, result.q, row))
+                    prev2, prev = prev, result.q
             print(
-                f"| {kind} | {actuation} | {np.mean(steps):.3f} | {max(steps)} | {fallbacks} "
-                f"| {error:.1e} |"
+                f"| | {actuation} | {reference} | {np.mean(steps):.3f} | {max(steps)} "
+                f"| {fallbacks} | {error:.1e} | {crossing} of {len(cases)} |"
             )
 
 
 if __name__ == "__main__":
     main()
+    random_motions()

@@ -151,6 +151,8 @@ def solve3(m: Sequence[Sequence[float]], b: Sequence[float]) -> tuple[list[float
 
 @dataclass(frozen=True)
 class NewtonResult:
+    """Outcome of :func:`closure_newton`."""
+
     q: Pose
     converged: bool
     iterations: int  # Newton steps taken (Jacobian solves)
@@ -174,7 +176,8 @@ def closure_newton(
     metric to ``max_step`` (default: the platform's RMS radius ``rho``) and halves it until the
     largest residual drops by the Armijo factor ``1 - t/2`` (at most ``max_halvings`` times).
     Converged when the largest residual is at most ``tol`` (rad or m). Fails (``converged``
-    False) on a singular ``J``, a failed line search, or ``max_iter`` steps.
+    False) on a singular ``J`` (``|det J|`` below 1e-14 of the product of its row norms), a
+    failed line search, or ``max_iter`` steps.
     """
     limit = geom.rho if max_step is None else max_step
     q = (float(q0[0]), float(q0[1]), float(q0[2]))
@@ -190,8 +193,9 @@ def closure_newton(
             break
         J = actuator_jacobian(geom, actuation, q)
         dq, det = solve3(J, [-v for v in r])
-        scale = max(1.0, *(abs(J[i][j]) for i in range(3) for j in range(3))) ** 3
-        if not abs(det) > 1e-14 * scale:
+        # |det J| against Hadamard's bound, the product of the row norms: scale-free.
+        bound = math.prod(math.sqrt(sum(v * v for v in row)) for row in J)
+        if not abs(det) > 1e-14 * bound:
             return NewtonResult(q, False, iteration, det)
         size = math.sqrt(dq[0] ** 2 + dq[1] ** 2 + (geom.rho * dq[2]) ** 2)
         t = min(1.0, limit / size) if size > 0 else 1.0
@@ -478,6 +482,7 @@ def prismatic_modes(
     qa: Sequence[float],
     coefficients: Sequence[float] | None = None,
     method: str = "roots",
+    samples: int = 256,
 ) -> list[Pose]:
     """Every assembly mode of prismatic actuation (at most 6), sorted by phi in ``(-pi, pi]``.
 
@@ -494,7 +499,7 @@ def prismatic_modes(
     if method == "roots":
         angles = sextic_angles_by_roots(coefficients)
     elif method == "sampling":
-        angles = sextic_angles_by_sampling(coefficients)
+        angles = sextic_angles_by_sampling(coefficients, samples)
     else:
         raise ValueError(f"method must be 'roots' or 'sampling', got {method!r}")
     modes: list[Pose] = []
@@ -558,6 +563,12 @@ def tracked_forward_kinematics(
        unwrapped next to ``q_near[2]``; the nearest in ``(x, y, rho*phi)`` wins. No mode: NaN.
 
     ``phi`` of the result is unwrapped next to ``q_near[2]``.
+
+    Which reference: the constant-velocity prediction ``2 q[k-1] - q[k-2]`` of the two previous
+    solutions is better than ``q[k-1]``: fewer Newton steps, and it is the only one that follows
+    the robot through a parallel singularity. There the two modes merge and part again, and the
+    mode nearest the previous pose (and of its aspect) is the one that turns back, while the
+    robot goes on into the other aspect, which the prediction is in.
     """
     near = (float(q_near[0]), float(q_near[1]), float(q_near[2]))
     result = closure_newton(geom, actuation, qa, near, max_iter=max_iter, tol=tol)
@@ -577,7 +588,7 @@ def tracked_forward_kinematics(
     if actuation == "revolute":
         modes = revolute_modes(geom, qa)
     else:
-        modes = prismatic_modes(geom, qa, method="sampling")
+        modes = prismatic_modes(geom, qa, method="sampling", samples=samples)
     best: Pose | None = None
     for m in modes:
         m = (m[0], m[1], unwrap_near(m[2], near[2]))

@@ -481,24 +481,50 @@ def test_unreachable_lengths_have_no_mode() -> None:
 # Tracked forward kinematics
 
 
+def _track(geom: fk.Geometry, actuation: str, qa: np.ndarray, q0, predict: bool) -> tuple:
+    """Track ``qa`` sample by sample from the pose ``q0``: the reference is the previous solution
+    or the constant-velocity prediction ``2 q[k-1] - q[k-2]``. Returns the solutions (n, 3), the
+    Newton steps (n,) and the statuses."""
+    prev = prev2 = tuple(q0)
+    out, steps, statuses = [], [], []
+    for row in qa:
+        near = tuple(2 * np.array(prev) - np.array(prev2)) if predict else prev
+        result = fk.tracked_forward_kinematics(geom, actuation, row, near)
+        out.append(result.q)
+        steps.append(result.iterations)
+        statuses.append(result.status)
+        prev2, prev = prev, result.q
+    return np.array(out), np.array(steps), statuses
+
+
 @pytest.mark.parametrize("actuation", ACTUATIONS)
-def test_tracking_follows_the_paper_trajectories(actuation: str) -> None:
-    """Encoders sampled every 1 ms; each solve starts from the previous one."""
+@pytest.mark.parametrize("predict", [False, True], ids=["previous", "predicted"])
+def test_tracking_follows_the_paper_trajectories(actuation: str, predict: bool) -> None:
+    """Encoders sampled every 1 ms; each solve starts from the previous one, or from the
+    constant-velocity prediction."""
     params = ne.paper_params()
     geom = fk.Geometry.from_params(params)
     for kind in ("rotation", "rectilinear"):
         _, q, _, _ = ne.paper_motion(kind, samples=3001)
         qa = _reference_qa(params, actuation, q)
-        near = tuple(q[0])
-        iterations = []
-        for k in range(len(q)):
-            result = fk.tracked_forward_kinematics(geom, actuation, qa[k], near)
-            assert result.status == "newton"
-            assert fk.distance(geom, result.q, q[k]) < 1e-10
-            iterations.append(result.iterations)
-            near = result.q
-        assert np.mean(iterations) <= 2.0
-        assert max(iterations) <= 3
+        found, steps, statuses = _track(geom, actuation, qa, q[0], predict)
+        assert set(statuses) == {"newton"}
+        assert np.abs(found - q).max() < 1e-10
+        assert steps.max() <= (1 if predict else 2)
+
+
+def test_tracking_through_a_parallel_singularity() -> None:
+    """A random motion that crosses det J = 0 (revolute actuation): the two modes merge and part
+    again; the prediction follows the robot into the other aspect."""
+    t = np.arange(0.0, 2.0, 1e-3)
+    robot, q, _, _ = ne.random_case(8, t)
+    params = robot["params"]
+    geom = fk.Geometry.from_params(params)
+    dets = [fk.det3(fk.actuator_jacobian(geom, "revolute", row)) for row in q]
+    assert min(dets) < 0 < max(dets)  # it does cross
+    qa = _reference_qa(params, "revolute", q)
+    found, _, _ = _track(geom, "revolute", qa, q[0], predict=True)
+    assert np.abs(found - q).max() < 1e-7
 
 
 @pytest.mark.parametrize("actuation", ACTUATIONS)
