@@ -398,7 +398,6 @@ def test_prismatic_modes_round_trip(models: dict[str, Model]) -> None:
                 assert _closes(params, "prismatic", qa, mode)
             assert any(_near(geom, m, pose) for m in modes)
     assert max(counts) > 2  # configurations with four or six real modes exist, and are found
-    assert 6 in counts or 4 in counts
 
 
 def test_six_real_modes_are_all_found() -> None:
