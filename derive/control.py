@@ -1,0 +1,910 @@
+"""The control model of the 3-RPR robot: actuator Jacobian, task-space dynamics, forward kinematics.
+
+Everything here appends named assignments to a :class:`~rpr3gen_derive.symbols.Program`, as the
+inverse dynamics does, so that the code-generation engine can turn it into NumPy and C functions.
+
+- Actuator coordinates ``qa`` (:data:`qa`): ``phi10_A..C`` (revolute actuation) or
+  ``lambda21_A..C`` (prismatic), measured from the central configuration; actuator efforts
+  ``tau`` (:data:`tau`): ``m10_A..C`` or ``f21z_A..C`` (conventions.md).
+- :func:`actuator_jacobian` and :func:`jacobian_rate_term`: ``qa' = J q'``,
+  ``qa'' = J q'' + J' q'``, by differentiating the leg kinematics of eqs. (6) and (9).
+- :func:`task_space_dynamics`: ``M q'' + c = J^T tau``, from the virtual-work derivation of the
+  loads (eqs. 10-17), which is affine in ``q''``.
+- :func:`forward_dynamics`: ``q'' = M^-1 (J^T tau - c)`` by an explicit LDL^T solve.
+- :func:`assembly_modes_revolute` (closed form, at most 2 modes), :func:`sextic_coefficients`
+  and :func:`pose_from_angle` (prismatic actuation, at most 6 modes): the direct kinematics.
+
+The numeric side (all modes from the sextic, tracked Newton FK) is in ``fk_tracking``, which
+needs only NumPy. See ``CONTROL_NOTES.md`` for the mathematics and the operation counts.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from functools import cache
+from typing import NamedTuple
+
+import sympy as sp
+from rpr3gen_derive import symbols as syms
+from rpr3gen_derive.dynamics import BodyMotion, LegWrenches, leg_wrenches, required_wrench
+from rpr3gen_derive.frames import u3
+from rpr3gen_derive.kinematics import LegKinematics, leg_kinematics, platform_rotation
+from rpr3gen_derive.specs import ACTUATIONS, FunctionSpec, derive
+from rpr3gen_derive.symbols import LEGS, PARAM_NAMES, Program
+from rpr3gen_derive.virtual_work import platform_radius_squared
+
+STEP_JACOBIAN = "actuator Jacobian, d qa / d q, from eq. (6)"
+STEP_RATE = "actuator accelerations at zero platform acceleration, eq. (9)"
+STEP_TANGENT = "loads differentiated with respect to the platform acceleration, eqs. (10)-(17)"
+STEP_BIAS = "loads at zero platform acceleration, eqs. (10)-(17)"
+STEP_TASK = "task-space dynamics, M q'' + c = J^T tau"
+STEP_FORWARD = "forward dynamics, LDL^T solve of M q'' = J^T tau - c"
+STEP_FK_REVOLUTE = "direct kinematics, revolute actuation (closed form)"
+STEP_FK_PRISMATIC = "direct kinematics, prismatic actuation (sextic in tan(phi/2))"
+
+QA_NAMES: tuple[str, ...] = tuple(f"qa_{leg}" for leg in LEGS)
+TAU_NAMES: tuple[str, ...] = tuple(f"tau_{leg}" for leg in LEGS)
+
+#: Measured actuator coordinates (rad or m) and commanded actuator efforts (N m or N), inputs.
+qa = sp.Matrix([sp.Symbol(name, real=True) for name in QA_NAMES])
+tau = sp.Matrix([sp.Symbol(name, real=True) for name in TAU_NAMES])
+
+
+@dataclass(frozen=True)
+class Actuator:
+    """Names of the actuated joint's coordinate, rate, acceleration and effort (conventions.md)."""
+
+    coordinate: str
+    rate: str
+    acceleration: str
+    effort: str
+
+
+ACTUATORS: dict[str, Actuator] = {
+    "revolute": Actuator("phi10", "omega10", "eps10", "m10"),
+    "prismatic": Actuator("lambda21", "v21", "gamma21", "f21z"),
+}
+
+#: Most assembly modes for given actuator coordinates (interfaces.md, RPR3_MAX_MODES).
+MAX_MODES: dict[str, int] = {"revolute": 2, "prismatic": 6}
+
+#: A leg shorter than this times the platform's RMS radius has no length (not an assembly mode).
+LENGTH_TOL = 1e-9
+#: Revolute direct kinematics: legs within this angle (rad) of all parallel (``|k|``), or
+#: ``|(A, B)|`` below this times ``|k| rho``, are degenerate (round-off is ~1e-16 of either).
+DEGENERACY_TOL = 1e-10
+
+#: Upper triangle of the symmetric 3 x 3 mass matrix, row-major.
+UPPER: tuple[tuple[int, int], ...] = ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))
+
+
+_RESERVED = frozenset(PARAM_NAMES) | frozenset(
+    s.name for s in (*syms.q, *syms.qd, *syms.qdd, *qa, *tau)
+)
+
+
+class _Builder:
+    """Defines assignments in a program, reusing one that has the same right-hand side.
+
+    An assignment of the same name and right-hand side is reused (so that the functions of this
+    module can share a program in any order); with ``share``, so is one of another name (so that,
+    e.g., the derivative of a velocity and of an acceleration by the same input is one symbol).
+    """
+
+    def __init__(self, prog: Program) -> None:
+        self.prog = prog
+        self.existing = prog.definitions()
+        self.by_expr: dict[sp.Expr, sp.Symbol] = {}
+        for symbol, expr in self.existing.items():
+            self.by_expr.setdefault(expr, symbol)
+
+    def define(self, name: str, expr: sp.Expr, step: str, share: bool = True) -> sp.Expr:
+        expr = sp.sympify(expr)
+        if name in _RESERVED:
+            raise ValueError(f"{name!r} is an input or a parameter, not a name for an assignment")
+        symbol = sp.Symbol(name, real=True)
+        if symbol in self.existing:
+            if self.existing[symbol] != expr:
+                raise ValueError(f"{name} is already defined differently in the program")
+            return symbol
+        if share and expr in self.by_expr:
+            return self.by_expr[expr]
+        out = self.prog.define(name, expr, step)
+        if out == symbol:
+            self.existing[symbol] = expr
+            self.by_expr.setdefault(expr, symbol)
+        return out
+
+
+# ----------------------------------------------------------------------------------------------
+# The inverse-dynamics program, and differentiation of a program assignment by assignment.
+
+
+@dataclass(frozen=True)
+class Derivation:
+    """The inverse-dynamics program of ``specs.derive`` with the structure the control model uses.
+
+    ``kinematics`` and ``wrenches`` are the per-leg objects of eqs. (5)-(11); their symbols are
+    assignments of ``program`` (same names, same expressions).
+    """
+
+    actuation: str
+    program: Program
+    outputs: dict[str, sp.Expr]
+    kinematics: dict[str, LegKinematics]
+    wrenches: dict[str, LegWrenches]
+
+
+@cache
+def inverse_dynamics(actuation: str) -> Derivation:
+    """``specs.derive(actuation)`` (eqs. 5-17), with its leg kinematics and wrenches.
+
+    The program is the one of ``specs.derive``; the leg objects are rebuilt by the same steps on
+    a scratch program, which must reproduce the first assignments of it exactly (else the
+    derivation changed under us, and this raises).
+    """
+    if actuation not in ACTUATIONS:
+        raise ValueError(f"actuation must be one of {ACTUATIONS}, got {actuation!r}")
+    program, outputs = derive(actuation)
+    scratch = Program()
+    cos_phi, sin_phi = platform_rotation(scratch)
+    kinematics = {leg: leg_kinematics(scratch, leg, cos_phi, sin_phi) for leg in LEGS}
+    wrenches = {
+        leg: leg_wrenches(scratch, kinematics[leg], carries_platform=(leg == LEGS[0]))
+        for leg in LEGS
+    }
+    prefix = program.assignments[: len(scratch.assignments)]
+    if prefix != scratch.assignments:
+        raise RuntimeError("specs.derive no longer starts with the leg kinematics and wrenches")
+    return Derivation(actuation, program, outputs, kinematics, wrenches)
+
+
+def include_inverse_dynamics(prog: Program, actuation: str) -> Derivation:
+    """Append the inverse-dynamics program to ``prog`` (once) and return its structure.
+
+    Assignments that ``prog`` already has with the same right-hand side are skipped, so the
+    functions of this module can be called on one program in any order.
+    """
+    derivation = inverse_dynamics(actuation)
+    bld = _Builder(prog)
+    for a in derivation.program.assignments:
+        bld.define(a.symbol.name, a.expr, a.step, share=False)
+    return derivation
+
+
+def _needed(prog: Program, exprs: Sequence[sp.Expr]) -> set[sp.Symbol]:
+    """The program symbols that ``exprs`` depend on, directly or through other assignments."""
+    definitions = prog.definitions()
+    needed: set[sp.Symbol] = set()
+    stack = [s for e in exprs for s in sp.sympify(e).free_symbols]
+    while stack:
+        s = stack.pop()
+        if s in needed or s not in definitions:
+            continue
+        needed.add(s)
+        stack.extend(definitions[s].free_symbols)
+    return needed
+
+
+def _ordered(symbols: set[sp.Symbol]) -> list[sp.Symbol]:
+    return sorted(symbols, key=lambda s: s.name)
+
+
+#: A derivative in factored form: ``sum of coefficient * seed``, the seed a vector over ``wrt``.
+Factored = list[tuple[sp.Expr, tuple[sp.Expr, ...]]]
+
+
+def differentiate_factored(
+    prog: Program, exprs: Sequence[sp.Expr], wrt: Sequence[sp.Symbol], step: str
+) -> list[Factored]:
+    """Forward-mode derivatives of ``exprs`` by ``wrt``, one assignment of ``prog`` at a time.
+
+    The derivative of an assignment is kept as a sum over a few *seed* vectors with scalar
+    coefficients: a seed is the vector of direct partial derivatives ``d_{name}_d_{var}`` of an
+    assignment that uses ``wrt`` itself (e.g. the acceleration of A3 along a leg's normal, by
+    ``q''``), and every later assignment only combines the coefficients of its arguments by the
+    chain rule (``k_{name}__{seed}``, one scalar each, shared by all the variables). So a leg's
+    whole chain of wrenches costs a few scalars, and its share of the mass matrix stays a rank-one
+    product. Nothing is expanded down to the inputs.
+    """
+    wrt = list(wrt)
+    needed = _needed(prog, exprs)
+    bld = _Builder(prog)
+    seeds: list[tuple[str, tuple[sp.Expr, ...]]] = []
+    seed_of: dict[tuple[sp.Expr, ...], int] = {}
+    tangent: dict[sp.Symbol, dict[int, sp.Expr]] = {}
+
+    def chain(expr: sp.Expr, name: str | None) -> dict[int, sp.Expr]:
+        terms: dict[int, sp.Expr] = {}
+        for a in _ordered(expr.free_symbols & tangent.keys()):
+            partial = sp.diff(expr, a)
+            for index, coeff in tangent[a].items():
+                terms[index] = terms.get(index, sp.Integer(0)) + partial * coeff
+        direct = [sp.diff(expr, var) for var in wrt]
+        if any(d != 0 for d in direct):
+            if name is None:
+                vector = tuple(direct)
+            else:
+                vector = tuple(
+                    bld.define(f"d_{name}_d_{var.name}", d, step)
+                    for var, d in zip(wrt, direct, strict=True)
+                )
+            if vector not in seed_of:
+                seed_of[vector] = len(seeds)
+                seeds.append((name or f"seed{len(seeds)}", vector))
+            index = seed_of[vector]
+            terms[index] = terms.get(index, sp.Integer(0)) + 1
+        return {i: c for i, c in terms.items() if c != 0}
+
+    for a in list(prog.assignments):
+        if a.symbol not in needed or not a.expr.free_symbols & (tangent.keys() | set(wrt)):
+            continue
+        terms = chain(a.expr, a.symbol.name)
+        tangent[a.symbol] = {
+            i: bld.define(f"k_{a.symbol.name}__{seeds[i][0]}", c, step) for i, c in terms.items()
+        }
+    out = []
+    for expr in exprs:
+        terms = chain(sp.sympify(expr), None)
+        out.append([(c, seeds[i][1]) for i, c in sorted(terms.items())])
+    return out
+
+
+def expand_factored(factored: Factored, size: int) -> list[sp.Expr]:
+    """The derivative vector ``sum_i coeff_i * seed_i`` of a factored derivative."""
+    return [sum((c * seed[k] for c, seed in factored), sp.Integer(0)) for k in range(size)]
+
+
+def differentiate(
+    prog: Program, exprs: Sequence[sp.Expr], wrt: Sequence[sp.Symbol], step: str
+) -> list[list[sp.Expr]]:
+    """``d exprs[i] / d wrt[k]`` as a ``len(exprs) x len(wrt)`` table (see
+    :func:`differentiate_factored`, which names the intermediate derivatives in ``prog``)."""
+    factored = differentiate_factored(prog, exprs, wrt, step)
+    return [expand_factored(f, len(wrt)) for f in factored]
+
+
+def at_zero(
+    prog: Program, exprs: Sequence[sp.Expr], variables: Sequence[sp.Symbol], suffix: str, step: str
+) -> list[sp.Expr]:
+    """``exprs`` with ``variables`` set to zero, as new assignments ``{name}{suffix}``.
+
+    Only the assignments that depend on ``variables`` are copied; the rest are shared.
+    """
+    needed = _needed(prog, exprs)
+    bld = _Builder(prog)
+    replace: dict[sp.Symbol, sp.Expr] = {v: sp.Integer(0) for v in variables}
+    for a in list(prog.assignments):
+        if a.symbol in needed and a.expr.free_symbols & replace.keys():
+            replace[a.symbol] = bld.define(
+                f"{a.symbol.name}{suffix}", a.expr.xreplace(replace), step
+            )
+    return [sp.sympify(e).xreplace(replace) for e in exprs]
+
+
+def _depends_on(prog: Program, expr: sp.Expr, variables: Sequence[sp.Symbol]) -> bool:
+    """True when ``expr`` depends on ``variables``, directly or through assignments."""
+    definitions = prog.definitions()
+    targets = set(variables)
+    seen: set[sp.Symbol] = set()
+    stack = list(sp.sympify(expr).free_symbols)
+    while stack:
+        s = stack.pop()
+        if s in targets:
+            return True
+        if s in seen or s not in definitions:
+            continue
+        seen.add(s)
+        stack.extend(definitions[s].free_symbols)
+    return False
+
+
+# ----------------------------------------------------------------------------------------------
+# Actuator Jacobian and its rate term.
+
+
+def _leg_rates(prog: Program, actuation: str, family: str) -> list[sp.Expr]:
+    derivation = include_inverse_dynamics(prog, actuation)
+    return [getattr(derivation.kinematics[leg], family) for leg in LEGS]
+
+
+def actuator_jacobian(prog: Program, actuation: str) -> sp.Matrix:
+    """``J = d qa / d q`` (3 x 3, one row per leg A, B, C), so that ``qa' = J q'``.
+
+    The rows are the connectivity conditions (6) differentiated with respect to the platform
+    velocity: with ``e`` the leg axis, ``n`` its normal, ``L = |A1A3|`` and ``s = A3 - G``,
+    ``omega10 = n . vA3 / L`` gives the row ``(n_x, n_y, e . s) / L`` (revolute actuation) and
+    ``v21 = e . vA3`` the row ``(e_x, e_y, s_x e_y - s_y e_x)`` (prismatic). Units: 1/m, 1
+    (revolute); 1, m (prismatic). ``det J = 0`` is the parallel singularity.
+    """
+    rates = _leg_rates(prog, actuation, ACTUATORS[actuation].rate)
+    rows = differentiate(prog, rates, list(syms.qd), STEP_JACOBIAN)
+    return sp.Matrix(rows)
+
+
+def jacobian_rate_term(prog: Program, actuation: str) -> sp.Matrix:
+    """``J' q'`` (3-vector): the actuator accelerations of eq. (9) at zero platform acceleration.
+
+    ``qa'' = J q'' + J' q'``: ``eps10`` (revolute) or ``gamma21`` (prismatic) of eq. (9), whose
+    part free of ``q''`` is ``J' q'``, e.g. ``eps10 = (n . aA3 - 2 v21 omega10) / L``.
+    """
+    accelerations = _leg_rates(prog, actuation, ACTUATORS[actuation].acceleration)
+    return sp.Matrix(at_zero(prog, accelerations, list(syms.qdd), "_qdd0", STEP_RATE))
+
+
+# ----------------------------------------------------------------------------------------------
+# Task-space dynamics and forward dynamics.
+
+
+def _symmetric(prog: Program, name: str, entries: dict[tuple[int, int], sp.Expr]) -> sp.Matrix:
+    """A symmetric matrix from its upper triangle, each entry named once as ``{name}{i}{j}``."""
+    bld = _Builder(prog)
+    upper = {
+        (i, j): bld.define(f"{name}{i + 1}{j + 1}", entries[i, j], STEP_TASK) for i, j in UPPER
+    }
+    return sp.Matrix(3, 3, lambda i, j: upper[min(i, j), max(i, j)])
+
+
+def _effort_affine(prog: Program, actuation: str) -> tuple[sp.Matrix, sp.Matrix]:
+    """``tau = A q'' + b``: the actuator loads of eqs. (12)-(17) split by their affinity in q''."""
+    derivation = include_inverse_dynamics(prog, actuation)
+    efforts = [derivation.outputs[f"{ACTUATORS[actuation].effort}_{leg}"] for leg in LEGS]
+    A = sp.Matrix(differentiate(prog, efforts, list(syms.qdd), STEP_TANGENT))
+    for entry in A:
+        if _depends_on(prog, entry, list(syms.qdd)):
+            raise RuntimeError("the actuator loads are not affine in the platform acceleration")
+    b = sp.Matrix(at_zero(prog, efforts, list(syms.qdd), "_qdd0", STEP_BIAS))
+    return A, b
+
+
+def _leg_wrench_components(
+    prog: Program, derivation: Derivation
+) -> dict[str, tuple[sp.Expr, sp.Expr]]:
+    """Per leg, the moment about A1 (z0) and the axial force (e) that the leg's own two bodies
+    require: ``M1_z`` and ``F2_z`` of the recursion (10)-(11) run without the platform.
+
+    They are built by ``dynamics.leg_wrenches(..., carries_platform=False)`` on a scratch
+    program; its assignments that ``prog`` already has are reused, and the few that differ there
+    (leg A's chain carries the platform in the inverse dynamics) are substituted in place.
+    """
+    bld = _Builder(prog)
+    out = {}
+    for leg in LEGS:
+        scratch = Program()
+        own = leg_wrenches(scratch, derivation.kinematics[leg], carries_platform=False)
+        inline: dict[sp.Symbol, sp.Expr] = {}
+        for a in scratch.assignments:
+            expr = a.expr.xreplace(inline)
+            known = bld.existing.get(a.symbol)
+            if known is None:
+                bld.define(a.symbol.name, expr, a.step, share=False)
+            elif known != expr:
+                inline[a.symbol] = expr
+        out[leg] = (own.M[0][2].xreplace(inline), own.F[1][2].xreplace(inline))
+    return out
+
+
+def _platform_wrench() -> sp.Matrix:
+    """The wrench the platform requires, at G in the world frame: ``(F_x, F_y, M_z)``.
+
+    ``dynamics.required_wrench`` (inertia, weight and payload, as for every body of eqs. 10-11)
+    applied to the platform about its centre G, whose velocity and acceleration are the inputs.
+    """
+    motion = BodyMotion(
+        omega=syms.dphi * u3,
+        eps=syms.ddphi * u3,
+        gamma=sp.Matrix([syms.ddx, syms.ddy, 0]),
+    )
+    force, moment = required_wrench(
+        motion,
+        syms.m3,
+        sp.zeros(3, 1),
+        sp.diag(0, 0, syms.J3),
+        syms.gravity,
+        external_force=syms.payload_force,
+        external_moment=syms.payload_moment,
+    )
+    return sp.Matrix([force[0], force[1], moment[2]])
+
+
+def _virtual_powers(prog: Program, actuation: str) -> list[tuple[tuple[sp.Expr, ...], sp.Expr]]:
+    """``J^T tau = sum_m row_m * w_m``: the virtual power of the required wrenches per unit twist.
+
+    Give the platform a virtual twist ``e_k`` (principle of virtual work, as for eqs. 12-17). Leg
+    i then turns by ``omega10 = J10_i e_k`` and slides by ``v21 = J21_i e_k`` (eq. 6), and its
+    cylinder and piston absorb the power ``omega10 M1z_i + v21 F2z_i`` of their required wrenches
+    (:func:`_leg_wrench_components`); the platform absorbs ``e_k . (F_x, F_y, M_z)`` of its own
+    (:func:`_platform_wrench`). The actuators supply ``tau . J e_k``, so the sum is
+    ``(J^T tau)_k`` whatever joints are actuated. ``J10``, ``J21`` are kept in factored form
+    (seed vector times scalar), so each term is a row vector times one named scalar ``w_m``.
+    """
+    derivation = include_inverse_dynamics(prog, actuation)
+    kinematics = derivation.kinematics
+    bld = _Builder(prog)
+    rates = [kinematics[leg].omega10 for leg in LEGS] + [kinematics[leg].v21 for leg in LEGS]
+    rows = differentiate_factored(prog, rates, list(syms.qd), STEP_JACOBIAN)
+    wrenches = _leg_wrench_components(prog, derivation)
+    terms: list[tuple[tuple[sp.Expr, ...], sp.Expr]] = []
+    for i, leg in enumerate(LEGS):
+        moment, force = wrenches[leg]
+        for family, factored, load in (("10", rows[i], moment), ("21", rows[3 + i], force)):
+            for k, (coeff, seed) in enumerate(factored):
+                w = bld.define(f"w{family}_{leg}_{k}", coeff * load, STEP_TASK)
+                terms.append((seed, w))
+    platform = _platform_wrench()
+    for k in range(3):
+        unit = tuple(sp.Integer(int(j == k)) for j in range(3))
+        terms.append((unit, bld.define(f"w3_{k + 1}", platform[k], STEP_TASK)))
+    return terms
+
+
+def task_space_dynamics(
+    prog: Program, actuation: str, method: str = "virtual_power"
+) -> tuple[sp.Matrix, sp.Matrix]:
+    """``M`` (3 x 3, symmetric positive definite) and ``c`` (3) with ``M q'' + c = J^T tau``.
+
+    The loads of the virtual-work derivation (eqs. 10-17) are affine in the platform
+    acceleration, ``tau = A(q) q'' + b(q, q')``, so ``M = J^T A`` and ``c = J^T b`` (units: kg,
+    kg m, kg m^2; N, N m). Two routes, equal to round-off (tested):
+
+    - ``method="efforts"``: exactly that. ``A`` by differentiating the program of
+      ``specs.derive`` assignment by assignment (:func:`differentiate`), ``b`` by setting
+      ``q'' = 0`` in it (:func:`at_zero`), then ``J^T A``, ``J^T b``. It carries the closure
+      solve of eq. (7) (``W^-1``, which ``J^T`` then undoes: ``W = -diag(L) J`` with revolute
+      actuation, ``diag(L) J`` with prismatic).
+    - ``method="virtual_power"`` (the default, about half the operations): ``J^T tau`` is the
+      virtual power of the same required wrenches (``dynamics.required_wrench`` and the
+      recursion 10-11 of each leg) in the unit platform twists, :func:`_virtual_powers`, so no
+      closure matrix is inverted; then the same differentiation and zeroing. ``M`` and ``c``
+      are those of the mechanism, the same for both actuations, and each leg adds a rank-one
+      term per joint: ``M = diag(m3, m3, J3) + sum_i (K_i J10_i^T J10_i + m2 J21_i^T J21_i)``
+      with ``K_i`` the inertia of cylinder and piston about A1.
+
+    ``M`` is positive definite wherever every leg has positive length, parallel singularities
+    included. Only its upper triangle is named (``M11 M12 M13 M22 M23 M33``); ``c`` is named
+    ``bias1..3``.
+    """
+    if method == "efforts":
+        A, b = _effort_affine(prog, actuation)
+        J = actuator_jacobian(prog, actuation)
+        mass = J.T * A
+        bias = J.T * b
+    elif method == "virtual_power":
+        terms = _virtual_powers(prog, actuation)
+        powers = [w for _, w in terms]
+        slopes = differentiate_factored(prog, powers, list(syms.qdd), STEP_TANGENT)
+        mass = sp.zeros(3, 3)
+        for (row, _), slope in zip(terms, slopes, strict=True):
+            column = expand_factored(slope, 3)
+            for i, j in UPPER:
+                mass[i, j] += row[i] * column[j]
+        for entry in mass:
+            if _depends_on(prog, entry, list(syms.qdd)):
+                raise RuntimeError("the generalized forces are not affine in q''")
+        at_rest = at_zero(prog, powers, list(syms.qdd), "_qdd0", STEP_BIAS)
+        bias = sp.zeros(3, 1)
+        for (row, _), w0 in zip(terms, at_rest, strict=True):
+            bias += sp.Matrix(row) * w0
+    else:
+        raise ValueError(f"method must be 'virtual_power' or 'efforts', got {method!r}")
+    M = _symmetric(prog, "M", {(i, j): mass[i, j] for i, j in UPPER})
+    bld = _Builder(prog)
+    c = sp.Matrix([bld.define(f"bias{k + 1}", bias[k], STEP_TASK) for k in range(3)])
+    return M, c
+
+
+def ldlt_solve(prog: Program, M: sp.Matrix, rhs: sp.Matrix, name: str, step: str) -> sp.Matrix:
+    """Solve ``M x = rhs`` for a symmetric positive definite 3 x 3 ``M`` by ``M = L D L^T``.
+
+    No square root; three divisions (the pivots ``D``). Every factor is a named assignment
+    ``{name}_...``; only the upper triangle of ``M`` is read.
+    """
+    bld = _Builder(prog)
+    d1 = bld.define(f"{name}_d1", M[0, 0], step)
+    inv_d1 = bld.define(f"{name}_inv_d1", 1 / d1, step)
+    l21 = bld.define(f"{name}_l21", M[0, 1] * inv_d1, step)
+    l31 = bld.define(f"{name}_l31", M[0, 2] * inv_d1, step)
+    d2 = bld.define(f"{name}_d2", M[1, 1] - l21 * M[0, 1], step)
+    inv_d2 = bld.define(f"{name}_inv_d2", 1 / d2, step)
+    l32 = bld.define(f"{name}_l32", (M[1, 2] - l21 * M[0, 2]) * inv_d2, step)
+    d3 = bld.define(f"{name}_d3", M[2, 2] - l31 * M[0, 2] - l32**2 * d2, step)
+    inv_d3 = bld.define(f"{name}_inv_d3", 1 / d3, step)
+    z1 = rhs[0]
+    z2 = bld.define(f"{name}_z2", rhs[1] - l21 * z1, step)
+    z3 = bld.define(f"{name}_z3", rhs[2] - l31 * z1 - l32 * z2, step)
+    x3 = bld.define(f"{name}_x3", z3 * inv_d3, step)
+    x2 = bld.define(f"{name}_x2", z2 * inv_d2 - l32 * x3, step)
+    x1 = bld.define(f"{name}_x1", z1 * inv_d1 - l21 * x2 - l31 * x3, step)
+    return sp.Matrix([x1, x2, x3])
+
+
+def forward_dynamics(prog: Program, actuation: str) -> sp.Matrix:
+    """``q'' = M^-1 (J^T tau - c)`` (3-vector), for the efforts :data:`tau`, by LDL^T.
+
+    ``M``, ``c`` of :func:`task_space_dynamics` (default route) and the 3 x 3 solve of
+    :func:`ldlt_solve`. Nothing here divides by ``det J``: the forward dynamics is defined at a
+    parallel singularity too (the efforts just cannot push the platform along the singular
+    direction); only a leg of zero length is singular. Units: m/s^2, m/s^2, rad/s^2.
+    """
+    M, c = task_space_dynamics(prog, actuation)
+    J = actuator_jacobian(prog, actuation)
+    rhs = J.T * tau - c
+    bld = _Builder(prog)
+    rhs = sp.Matrix([bld.define(f"fd_rhs{k + 1}", rhs[k], STEP_FORWARD) for k in range(3)])
+    return ldlt_solve(prog, M, rhs, "fd", STEP_FORWARD)
+
+
+# ----------------------------------------------------------------------------------------------
+# Direct kinematics.
+
+
+def _xy(v: sp.Matrix) -> tuple[sp.Expr, sp.Expr]:
+    return v[0], v[1]
+
+
+def _cross(a: tuple[sp.Expr, sp.Expr], b: tuple[sp.Expr, sp.Expr]) -> sp.Expr:
+    return a[0] * b[1] - a[1] * b[0]
+
+
+def _dot(a: tuple[sp.Expr, sp.Expr], b: tuple[sp.Expr, sp.Expr]) -> sp.Expr:
+    return a[0] * b[0] + a[1] * b[1]
+
+
+class Mode(NamedTuple):
+    """One assembly mode ``(x, y, phi, valid)``: the pose, and whether it exists (a Boolean)."""
+
+    x: sp.Expr
+    y: sp.Expr
+    phi: sp.Expr
+    valid: sp.Boolean
+
+
+def assembly_modes_revolute(prog: Program) -> list[Mode]:
+    """The two assembly modes of revolute actuation, in closed form, from the inputs :data:`qa`.
+
+    With the leg angles ``theta_i = alpha_i + qa_i`` known (eq. 5), each platform joint lies on
+    the line through ``A1_i`` along ``e_i``: ``n_i . (G + R(phi) p_i - A1_i) = 0``, i.e.
+    ``n_i . G + u_i cos(phi) + v_i sin(phi) = w_i`` with ``u_i = n_i . p_i``, ``v_i = e_i . p_i``,
+    ``w_i = n_i . A1_i``. The vector ``k = (sin(th_C - th_B), sin(th_A - th_C), sin(th_B - th_A))``
+    annihilates the ``G`` columns (``sum_i k_i n_i = 0``), which leaves
+    ``A cos(phi) + B sin(phi) + C = 0`` with ``A = k . u``, ``B = k . v``, ``C = -k . w``:
+    ``(cos, sin)(phi) = (-A C -/+ B r, -B C +/- A r) / (A^2 + B^2)``, ``r = sqrt(A^2 + B^2 - C^2)``.
+    ``G`` then solves the three (consistent) line equations in the least-squares sense,
+    ``N^T N G = N^T (w - u cos - v sin)`` with ``det(N^T N) = |k|^2``.
+
+    A mode is valid when it is real (``A^2 + B^2 >= C^2``) and every leg length
+    ``(A3 - A1) . e_i`` exceeds ``LENGTH_TOL`` times the platform's RMS radius ``rho``: the
+    round-off of a zero length is not a mode (the paper's robot, whose base and platform triangles
+    are congruent, has every leg of zero length at ``G = 0, phi = -pi/3`` whatever ``qa``).
+
+    Degenerate inputs have no isolated mode, and both modes are reported invalid: all legs
+    parallel (``|k| <= DEGENERACY_TOL``: G is not fixed), or ``A = B = 0``
+    (``|(A, B)| <= DEGENERACY_TOL |k| rho``), where the actuators do not fix the orientation:
+    either no pose at all (``C != 0``) or a continuum of them (``C = 0``, a self-motion). The
+    round-off of a zero ``k``, ``A`` or ``B`` is about 1e-16 of these scales.
+
+    ``phi`` is in ``[-pi, pi]`` (``atan2``); the two modes coincide where ``A^2 + B^2 = C^2``
+    (a parallel singularity). Units: m, m, rad.
+    """
+    step = STEP_FK_REVOLUTE
+    bld = _Builder(prog)
+    e, n, u, v, w = {}, {}, {}, {}, {}
+    for i, leg in enumerate(LEGS):
+        angle = syms.alpha(leg) + qa[i]
+        c = bld.define(f"fk_cos_theta_{leg}", sp.cos(angle), step)
+        s = bld.define(f"fk_sin_theta_{leg}", sp.sin(angle), step)
+        e[leg], n[leg] = (c, s), (-s, c)
+        p = _xy(syms.platform_joint(leg))
+        u[leg] = bld.define(f"fk_u_{leg}", _dot(n[leg], p), step)
+        v[leg] = bld.define(f"fk_v_{leg}", _dot(e[leg], p), step)
+        w[leg] = bld.define(f"fk_w_{leg}", _dot(n[leg], _xy(syms.base_pivot(leg))), step)
+    k = {
+        leg: bld.define(f"fk_k_{leg}", _cross(e[LEGS[(i + 1) % 3]], e[LEGS[(i + 2) % 3]]), step)
+        for i, leg in enumerate(LEGS)
+    }
+    A = bld.define("fk_A", sum(k[leg] * u[leg] for leg in LEGS), step)
+    B = bld.define("fk_B", sum(k[leg] * v[leg] for leg in LEGS), step)
+    C = bld.define("fk_C", -sum(k[leg] * w[leg] for leg in LEGS), step)
+    ab2 = bld.define("fk_AB2", A**2 + B**2, step)
+    disc = bld.define("fk_disc", ab2 - C**2, step)
+    root = bld.define("fk_root", sp.sqrt(sp.Max(disc, 0)), step)
+    inv_ab2 = bld.define("fk_inv_AB2", 1 / ab2, step)
+    # Normal equations of the three line conditions for G: N has rows n_i^T.
+    s_ss = sum(n[leg][0] ** 2 for leg in LEGS)
+    s_cc = sum(n[leg][1] ** 2 for leg in LEGS)
+    s_sc = sum(n[leg][0] * n[leg][1] for leg in LEGS)
+    ksq = bld.define("fk_ksq", sum(k[leg] ** 2 for leg in LEGS), step)
+    inv_ksq = bld.define("fk_inv_ksq", 1 / ksq, step)
+    min_length = platform_rms_radius()
+    modes = []
+    for m, sign in ((1, 1), (2, -1)):
+        cos_phi = bld.define(f"fk{m}_cos_phi", (-A * C - sign * B * root) * inv_ab2, step)
+        sin_phi = bld.define(f"fk{m}_sin_phi", (-B * C + sign * A * root) * inv_ab2, step)
+        phi = bld.define(f"fk{m}_phi", sp.atan2(sin_phi, cos_phi), step)
+        r = {leg: w[leg] - u[leg] * cos_phi - v[leg] * sin_phi for leg in LEGS}
+        b1 = bld.define(f"fk{m}_b1", sum(n[leg][0] * r[leg] for leg in LEGS), step)
+        b2 = bld.define(f"fk{m}_b2", sum(n[leg][1] * r[leg] for leg in LEGS), step)
+        x = bld.define(f"fk{m}_x", (s_cc * b1 - s_sc * b2) * inv_ksq, step)
+        y = bld.define(f"fk{m}_y", (s_ss * b2 - s_sc * b1) * inv_ksq, step)
+        lengths = []
+        for leg in LEGS:
+            p = syms.platform_joint(leg)
+            a1 = syms.base_pivot(leg)
+            d = (
+                x + cos_phi * p[0] - sin_phi * p[1] - a1[0],
+                y + sin_phi * p[0] + cos_phi * p[1] - a1[1],
+            )
+            lengths.append(bld.define(f"fk{m}_length_{leg}", _dot(e[leg], d), step))
+        valid = sp.And(
+            sp.GreaterThan(disc, 0),
+            sp.StrictGreaterThan(ab2, DEGENERACY_TOL**2 * ksq * platform_radius_squared()),
+            sp.StrictGreaterThan(ksq, DEGENERACY_TOL**2),
+            *(sp.StrictGreaterThan(length, LENGTH_TOL * min_length) for length in lengths),
+        )
+        modes.append(Mode(x, y, phi, valid))
+    return modes
+
+
+@dataclass(frozen=True)
+class _Harmonic:
+    """``f0 + fc cos(phi) + fs sin(phi)``: a trigonometric polynomial of degree one."""
+
+    f0: sp.Expr
+    fc: sp.Expr
+    fs: sp.Expr
+
+    def half_angle(self) -> list[sp.Expr]:
+        """``(1 + t^2) f`` in ``t = tan(phi/2)``, ascending: ``f0 + fc, 2 fs, f0 - fc``."""
+        return [self.f0 + self.fc, 2 * self.fs, self.f0 - self.fc]
+
+    def at(self, cos_phi: sp.Expr, sin_phi: sp.Expr) -> sp.Expr:
+        return self.f0 + self.fc * cos_phi + self.fs * sin_phi
+
+
+def _poly_mul(a: Sequence[sp.Expr], b: Sequence[sp.Expr]) -> list[sp.Expr]:
+    out = [sp.Integer(0)] * (len(a) + len(b) - 1)
+    for i, ai in enumerate(a):
+        for j, bj in enumerate(b):
+            out[i + j] += ai * bj
+    return out
+
+
+def _poly_define(bld: _Builder, name: str, poly: Sequence[sp.Expr], step: str) -> list[sp.Expr]:
+    return [bld.define(f"{name}_{k}", coeff, step) for k, coeff in enumerate(poly)]
+
+
+@dataclass(frozen=True)
+class _PrismaticClosure:
+    """The leg-A-relative quantities of the prismatic direct kinematics (see sextic docs)."""
+
+    length_a_sq: sp.Expr  # L_A^2
+    rho: dict[str, _Harmonic]  # rho_i, i = B, C: u . w_i = rho_i
+    w: dict[str, tuple[_Harmonic, _Harmonic]]  # w_i = R P_i - Q_i, x and y components
+    wsq: dict[str, _Harmonic]  # |w_i|^2
+    wbc: _Harmonic  # w_B . w_C
+    det: _Harmonic  # D = w_B x w_C
+
+
+def _prismatic_closure(bld: _Builder) -> _PrismaticClosure:
+    step = STEP_FK_PRISMATIC
+    ref, others = LEGS[0], LEGS[1:]
+    length = {
+        leg: bld.define(f"fkp_L_{leg}", syms.l0 + syms.l2 + qa[i], step)
+        for i, leg in enumerate(LEGS)
+    }
+    pa, aa = _xy(syms.platform_joint(ref)), _xy(syms.base_pivot(ref))
+    P, Q = {}, {}
+    for leg in others:
+        p, a = _xy(syms.platform_joint(leg)), _xy(syms.base_pivot(leg))
+        P[leg] = (p[0] - pa[0], p[1] - pa[1])
+        Q[leg] = (a[0] - aa[0], a[1] - aa[1])
+    rho, w, wsq = {}, {}, {}
+
+    def harmonic(name: str, f0: sp.Expr, fc: sp.Expr, fs: sp.Expr) -> _Harmonic:
+        parts = zip("0cs", (f0, fc, fs), strict=True)
+        return _Harmonic(*(bld.define(f"{name}_{k}", f, step) for k, f in parts))
+
+    la2 = bld.define("fkp_LA2", length[ref] ** 2, step)
+    for leg in others:
+        qp = bld.define(f"fkp_QP_{leg}", _dot(Q[leg], P[leg]), step)  # Q . P
+        pq = bld.define(f"fkp_PxQ_{leg}", _cross(P[leg], Q[leg]), step)  # P x Q
+        norms = bld.define(f"fkp_PPQQ_{leg}", _dot(P[leg], P[leg]) + _dot(Q[leg], Q[leg]), step)
+        # u . w_i = rho_i, from |u + w_i|^2 = L_i^2 and |u|^2 = L_A^2; Q . R P = c QP + s PxQ.
+        rho[leg] = harmonic(f"fkp_rho_{leg}", (length[leg] ** 2 - la2 - norms) / 2, qp, pq)
+        wsq[leg] = _Harmonic(norms, -2 * qp, -2 * pq)
+        # R P - Q = cos (P) + sin (-P_y, P_x) - Q
+        w[leg] = (
+            _Harmonic(-Q[leg][0], P[leg][0], -P[leg][1]),
+            _Harmonic(-Q[leg][1], P[leg][1], P[leg][0]),
+        )
+    b, c = others
+    wbc = harmonic(
+        "fkp_wBC",
+        _dot(P[b], P[c]) + _dot(Q[b], Q[c]),
+        -(_dot(Q[b], P[c]) + _dot(Q[c], P[b])),
+        -(_cross(P[c], Q[b]) + _cross(P[b], Q[c])),
+    )
+    det = harmonic(
+        "fkp_D",
+        _cross(P[b], P[c]) + _cross(Q[b], Q[c]),
+        _cross(P[c], Q[b]) - _cross(P[b], Q[c]),
+        _dot(P[b], Q[c]) - _dot(P[c], Q[b]),
+    )
+    return _PrismaticClosure(la2, rho, w, wsq, wbc, det)
+
+
+def sextic_coefficients(prog: Program) -> list[sp.Expr]:
+    """Coefficients ``a0..a6`` (ascending) of the direct-kinematics sextic in ``t = tan(phi/2)``.
+
+    Prismatic actuation, leg lengths ``L_i = l0 + l2 + qa_i`` (eq. 5). With ``u = A3 - A1`` of
+    leg A, ``P_i = p_i - p_A`` (platform frame) and ``Q_i = A1_i - A1_A`` (world), the equations
+    ``|u|^2 = L_A^2`` and ``|u + w_i|^2 = L_i^2`` with ``w_i = R(phi) P_i - Q_i`` (i = B, C) give,
+    by subtraction, two equations linear in ``u``: ``u . w_i = rho_i``,
+    ``rho_i = (L_i^2 - L_A^2 - |P_i|^2 - |Q_i|^2) / 2 + Q_i . R P_i``. Then
+    ``D u = rho_C w_B^perp - rho_B w_C^perp`` with ``D = w_B x w_C``, and ``|u|^2 = L_A^2``
+    becomes ``F(phi) = rho_C^2 |w_B|^2 + rho_B^2 |w_C|^2 - 2 rho_B rho_C w_B . w_C - L_A^2 D^2
+    = 0``. Each of ``rho_i``, ``|w_i|^2``, ``w_B . w_C``, ``D`` is ``f0 + fc cos + fs sin`` (the
+    rotation appears once), so ``F`` has trigonometric degree 3 and ``(1 + t^2)^3 F`` is a
+    polynomial of degree 6 in ``t`` (Gosselin & Sefrioui; Merlet): at most six modes.
+
+    ``a6 = F(pi)``: when ``phi = pi`` is a root the degree drops (the root is at ``t = inf``);
+    the numeric drivers of ``fk_tracking`` look for it there. A root with ``D = 0`` needs the
+    treatment described in :func:`pose_from_angle`. Units: m^6.
+    """
+    step = STEP_FK_PRISMATIC
+    bld = _Builder(prog)
+    k = _prismatic_closure(bld)
+    b, c = LEGS[1:]
+    rb = _poly_define(bld, "fkp_trho_B", k.rho[b].half_angle(), step)
+    rc = _poly_define(bld, "fkp_trho_C", k.rho[c].half_angle(), step)
+    wbb = k.wsq[b].half_angle()
+    wcc = k.wsq[c].half_angle()
+    wbc = k.wbc.half_angle()
+    det = _poly_define(bld, "fkp_tD", k.det.half_angle(), step)
+    # rho_C^2 |w_B|^2 + rho_B^2 |w_C|^2 - 2 rho_B rho_C w_B.w_C
+    #   = rho_C (rho_C |w_B|^2 - rho_B w_B.w_C) + rho_B (rho_B |w_C|^2 - rho_C w_B.w_C)
+    left = [x - y for x, y in zip(_poly_mul(rc, wbb), _poly_mul(rb, wbc), strict=True)]
+    right = [x - y for x, y in zip(_poly_mul(rb, wcc), _poly_mul(rc, wbc), strict=True)]
+    left = _poly_define(bld, "fkp_left", left, step)
+    right = _poly_define(bld, "fkp_right", right, step)
+    main = [x + y for x, y in zip(_poly_mul(rc, left), _poly_mul(rb, right), strict=True)]
+    det2 = _poly_define(bld, "fkp_tD2", _poly_mul(det, det), step)
+    one_plus_t2 = [sp.Integer(1), sp.Integer(0), sp.Integer(1)]
+    det_term = _poly_mul(det2, one_plus_t2)
+    return [bld.define(f"fkp_a{j}", main[j] - k.length_a_sq * det_term[j], step) for j in range(7)]
+
+
+def pose_from_angle(prog: Program, cos_phi: sp.Expr, sin_phi: sp.Expr) -> tuple[sp.Expr, sp.Expr]:
+    """``(x, y)`` of G for a root ``phi`` of the sextic (prismatic actuation), back substitution.
+
+    ``u = (rho_C w_B^perp - rho_B w_C^perp) / D`` (see :func:`sextic_coefficients`), then
+    ``G = A1_A + u - R(phi) p_A``. Singular where ``D = w_B x w_C = 0``: the two linear
+    equations for ``u`` are then parallel, or void. That happens at a root where two modes share
+    one orientation (``F`` then has a double root there), or at a spurious root where both
+    ``w_i`` vanish (base and platform triangles congruent at this angle: the paper's robot at
+    ``phi = -pi/3``, a root of ``F`` for any lengths). This function does not guard it; the
+    numeric driver (``fk_tracking.pose_candidates``) tests
+    ``|D| <= PARALLEL_TOL |w_B| |w_C|`` and then intersects the line ``u . w_i = rho_i`` of the
+    longer ``w_i`` with the circle ``|u| = L_A`` (two candidates, each polished by Newton on the
+    original equations), or drops the root when both ``w_i`` vanish (no isolated mode). Units: m.
+    """
+    step = STEP_FK_PRISMATIC
+    bld = _Builder(prog)
+    k = _prismatic_closure(bld)
+    b, c = LEGS[1:]
+    cs = (cos_phi, sin_phi)
+    rho_b = bld.define("fkp_rho_B", k.rho[b].at(*cs), step)
+    rho_c = bld.define("fkp_rho_C", k.rho[c].at(*cs), step)
+    wb = [bld.define(f"fkp_wB_{a}", h.at(*cs), step) for a, h in zip("xy", k.w[b], strict=True)]
+    wc = [bld.define(f"fkp_wC_{a}", h.at(*cs), step) for a, h in zip("xy", k.w[c], strict=True)]
+    inv_det = bld.define("fkp_inv_D", 1 / _cross((wb[0], wb[1]), (wc[0], wc[1])), step)
+    ux = (-rho_c * wb[1] + rho_b * wc[1]) * inv_det
+    uy = (rho_c * wb[0] - rho_b * wc[0]) * inv_det
+    p, a1 = syms.platform_joint(LEGS[0]), syms.base_pivot(LEGS[0])
+    x = bld.define("fkp_x", a1[0] + ux - (cos_phi * p[0] - sin_phi * p[1]), step)
+    y = bld.define("fkp_y", a1[1] + uy - (sin_phi * p[0] + cos_phi * p[1]), step)
+    return x, y
+
+
+def platform_rms_radius() -> sp.Expr:
+    """``rho = sqrt(mean |p_i|^2)`` (m): the length that turns ``phi`` into a distance."""
+    return sp.sqrt(platform_radius_squared())
+
+
+# ----------------------------------------------------------------------------------------------
+# Function specs for the code-generation engine.
+
+
+def _spec(
+    name: str,
+    actuation: str,
+    inputs: tuple[tuple[str, tuple[sp.Symbol, ...]], ...],
+    prog: Program,
+    outputs: Sequence[tuple[str, sp.Expr]],
+    doc: str,
+) -> FunctionSpec:
+    return FunctionSpec(
+        name=name,
+        actuation=actuation,
+        param_names=PARAM_NAMES,
+        inputs=inputs,
+        program=prog,
+        outputs=tuple(outputs),
+        docstring=doc,
+    )
+
+
+def _matrix_outputs(name: str, m: sp.Matrix) -> list[tuple[str, sp.Expr]]:
+    return [(f"{name}{i + 1}{j + 1}", m[i, j]) for i in range(m.rows) for j in range(m.cols)]
+
+
+def control_specs(actuation: str) -> dict[str, FunctionSpec]:
+    """One :class:`FunctionSpec` per control-model function, for the engine (and op counts).
+
+    Each spec has its own program, so that its op count is its own: ``actuator_jacobian``
+    (q -> J, row-major), ``jacobian_rate`` (q, qd -> J' q'), ``task_space_dynamics``
+    (q, qd -> M row-major, c), ``forward_dynamics`` (q, qd, tau -> qdd), and the direct
+    kinematics: ``assembly_modes`` (qa -> two modes x, y, phi) for revolute actuation, or
+    ``sextic`` (qa -> a0..a6) and ``pose_from_angle`` (qa, cos, sin -> x, y) for prismatic.
+    """
+    q_in = ("q", tuple(syms.q))
+    qd_in = ("qd", tuple(syms.qd))
+    specs: dict[str, FunctionSpec] = {}
+
+    prog = Program()
+    J = actuator_jacobian(prog, actuation)
+    specs["actuator_jacobian"] = _spec(
+        "rpr3_actuator_jacobian", actuation, (q_in,), prog, _matrix_outputs("J", J),
+        "Actuator Jacobian J = d qa / d q (row-major, one row per leg).",
+    )  # fmt: skip
+    prog = Program()
+    rate = jacobian_rate_term(prog, actuation)
+    specs["jacobian_rate"] = _spec(
+        "rpr3_jacobian_rate", actuation, (q_in, qd_in), prog,
+        [(f"Jdqd{k + 1}", rate[k]) for k in range(3)],
+        "J' q': actuator accelerations at zero platform acceleration.",
+    )  # fmt: skip
+    prog = Program()
+    M, c = task_space_dynamics(prog, actuation)
+    specs["task_space_dynamics"] = _spec(
+        "rpr3_task_space_dynamics", actuation, (q_in, qd_in), prog,
+        _matrix_outputs("M", M) + [(f"c{k + 1}", c[k]) for k in range(3)],
+        "Task-space dynamics M q'' + c = J^T tau (M row-major, symmetric).",
+    )  # fmt: skip
+    prog = Program()
+    qdd = forward_dynamics(prog, actuation)
+    specs["forward_dynamics"] = _spec(
+        "rpr3_forward_dynamics", actuation, (q_in, qd_in, ("tau", tuple(tau))), prog,
+        [(f"qdd{k + 1}", qdd[k]) for k in range(3)],
+        "Forward dynamics q'' = M^-1 (J^T tau - c).",
+    )  # fmt: skip
+    qa_in = ("qa", tuple(qa))
+    prog = Program()
+    if actuation == "revolute":
+        modes = assembly_modes_revolute(prog)
+        outputs = [
+            (f"{name}{m + 1}", getattr(mode, name))
+            for m, mode in enumerate(modes)
+            for name in ("x", "y", "phi")
+        ]
+        specs["assembly_modes"] = _spec(
+            "rpr3_assembly_modes", actuation, (qa_in,), prog, outputs,
+            "Both assembly modes (x, y, phi) of revolute actuation, closed form.",
+        )  # fmt: skip
+    else:
+        coefficients = sextic_coefficients(prog)
+        specs["sextic"] = _spec(
+            "rpr3_sextic", actuation, (qa_in,), prog,
+            [(f"a{k}", a) for k, a in enumerate(coefficients)],
+            "Coefficients a0..a6 of the direct-kinematics sextic in tan(phi/2).",
+        )  # fmt: skip
+        prog = Program()
+        angle = (sp.Symbol("cos_phi_in", real=True), sp.Symbol("sin_phi_in", real=True))
+        x, y = pose_from_angle(prog, *angle)
+        specs["pose_from_angle"] = _spec(
+            "rpr3_pose_from_angle", actuation, (qa_in, ("angle", angle)), prog,
+            [("x", x), ("y", y)],
+            "Position of G for a root phi of the sextic (back substitution).",
+        )  # fmt: skip
+    return specs
