@@ -1,4 +1,4 @@
-"""Operation counts and numeric statistics of the control model (derive/CONTROL_NOTES.md).
+"""Operation counts and numeric statistics of the control model (docs/control-model.md).
 
 Run with the project's interpreter (``dev`` extra)::
 
@@ -19,24 +19,25 @@ from pathlib import Path
 
 import numpy as np
 import sympy as sp
-from rpr3gen_derive import control
-from rpr3gen_derive import fk_tracking as fk
+from rpr3gen_derive.codegen.program import Program
+from rpr3gen_derive.rpr3 import control, registry
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
+import fk_reference as fk  # the numeric prototype, a test helper
 import newton_euler as ne  # the independent reference, a test helper
 
 
-def ops(spec) -> tuple[int, int]:
-    """Operations of the live assignments and outputs of ``spec``, before and after CSE."""
+def ops(program: Program, outputs: list[sp.Expr]) -> tuple[int, int]:
+    """Operations of the live assignments and ``outputs``, before and after CSE."""
     needed: set[sp.Symbol] = set()
-    for _, expr in spec.outputs:
+    for expr in outputs:
         needed |= sp.sympify(expr).free_symbols
     live = []
-    for a in reversed(spec.program.assignments):
+    for a in reversed(program.assignments):
         if a.symbol in needed:
             live.append(a.expr)
             needed |= a.expr.free_symbols
-    exprs = live[::-1] + [sp.sympify(e) for _, e in spec.outputs]
+    exprs = live[::-1] + [sp.sympify(e) for e in outputs]
     before = sum(int(sp.count_ops(e)) for e in exprs)
     temporaries, reduced = sp.cse(
         exprs, symbols=sp.numbered_symbols("x", real=True), order="canonical"
@@ -51,21 +52,15 @@ def main() -> None:
     print("| function | actuation | ops before CSE | ops after CSE |")
     print("|---|---|---|---|")
     for actuation in control.ACTUATIONS:
-        for name, spec in control.control_specs(actuation).items():
-            before, after = ops(spec)
-            print(f"| {name} | {actuation} | {before} | {after} |")
+        for spec in registry.module(actuation).functions:
+            if spec.c_body is None:  # guards (the failure checks' values) are counted too
+                exprs = [e for _, _, e in spec.flat_outputs()]
+                before, after = ops(spec.program, exprs)
+                print(f"| {spec.name} | {actuation} | {before} | {after} |")
         for method in ("efforts",):
-            prog = control.Program()
+            prog = Program()
             M, c = control.task_space_dynamics(prog, actuation, method=method)
-            spec = control._spec(
-                "rpr3_task_space_dynamics",
-                actuation,
-                (("q", tuple(control.syms.q)), ("qd", tuple(control.syms.qd))),
-                prog,
-                control._matrix_outputs("M", M) + [(f"c{k + 1}", c[k]) for k in range(3)],
-                "",
-            )
-            before, after = ops(spec)
+            before, after = ops(prog, [*M, *c])
             print(f"| task_space_dynamics (method={method}) | {actuation} | {before} | {after} |")
 
     print("\n| actuation | modes: samples with k modes |")

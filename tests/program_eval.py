@@ -12,7 +12,7 @@ from collections.abc import Callable, Mapping, Sequence
 
 import numpy as np
 import sympy as sp
-from rpr3gen_derive.symbols import Program
+from rpr3gen_derive.codegen.program import Program
 from sympy.printing.numpy import NumPyPrinter
 
 

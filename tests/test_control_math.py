@@ -1,4 +1,4 @@
-"""The control model's mathematics (derive/control.py, derive/fk_tracking.py), numerically.
+"""The control model's mathematics (derive/rpr3/control.py, tests/fk_reference.py), numerically.
 
 The symbolic expressions are evaluated assignment by assignment (``program_eval``) and checked
 against the independent Newton-Euler reference (``newton_euler``: inverse kinematics, joint loads,
@@ -12,14 +12,15 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
+import fk_reference as fk
 import numpy as np
 import pytest
 import sympy as sp
-from rpr3gen_derive import control
-from rpr3gen_derive import fk_tracking as fk
-from rpr3gen_derive import symbols as syms
-from rpr3gen_derive.specs import derive
-from rpr3gen_derive.symbols import PARAM_NAMES, Program
+from rpr3gen_derive.codegen.program import Program
+from rpr3gen_derive.rpr3 import control, registry
+from rpr3gen_derive.rpr3 import symbols as syms
+from rpr3gen_derive.rpr3.derivation import derive
+from rpr3gen_derive.rpr3.symbols import PARAM_NAMES
 
 try:
     from . import newton_euler as ne
@@ -60,7 +61,7 @@ def _build(actuation: str) -> Model:
     dynamics = compile_program(prog, inputs, outputs)
     if actuation == "revolute":
         modes = control.assembly_modes_revolute(prog)
-        fk_out = [getattr(m, name) for m in modes for name in ("x", "y", "phi", "valid")]
+        fk_out = [getattr(m, name) for m in modes for name in ("x", "y", "phi", "margin")]
         fk_fn = compile_program(prog, [*PARAMS, *control.qa], fk_out)
     else:
         coefficients = control.sextic_coefficients(prog)
@@ -150,7 +151,7 @@ def test_the_program_extends_the_inverse_dynamics_unchanged(model: Model) -> Non
 
 def test_names_never_shadow_parameters_or_inputs() -> None:
     for actuation in ACTUATIONS:
-        for spec in control.control_specs(actuation).values():
+        for spec in registry.module(actuation).functions:
             names = [a.symbol.name for a in spec.program.assignments]
             assert len(names) == len(set(names))
             assert not set(names) & set(control._RESERVED)
@@ -312,9 +313,11 @@ def test_revolute_modes_round_trip(models: dict[str, Model]) -> None:
         geom = fk.Geometry.from_params(params)
         poses = _random_poses(rng, 10)
         qa = _reference_qa(params, "revolute", poses)
-        out = np.array(model.fk(**_qa_inputs(params, qa)))  # (8, n): x, y, phi, valid per mode
+        out = np.array(model.fk(**_qa_inputs(params, qa)))  # (8, n): x, y, phi, margin per mode
         for n, (pose, qa_n) in enumerate(zip(poses, qa, strict=True)):
-            symbolic = [tuple(out[4 * m : 4 * m + 3, n]) for m in range(2) if out[4 * m + 3, n]]
+            symbolic = [
+                tuple(out[4 * m : 4 * m + 3, n]) for m in range(2) if out[4 * m + 3, n] >= 0
+            ]
             numeric = fk.revolute_modes(geom, qa_n)
             counts.append(len(numeric))
             assert len(symbolic) == len(numeric) <= 2
@@ -338,8 +341,8 @@ def test_revolute_degenerate_inputs_have_no_mode(models: dict[str, Model]) -> No
     qa = np.stack([parallel, unreachable])
     out = np.array(model.fk(**_qa_inputs(params, qa)))
     with np.errstate(all="ignore"):
-        assert not out[3].any()
-        assert not out[7].any()
+        assert not (out[3] >= 0).any()  # margins: a mode exists where >= 0
+        assert not (out[7] >= 0).any()
     for q in qa:
         assert fk.revolute_modes(geom, q) == []
     # The paper's congruent triangles: every leg has zero length at G = 0, phi = -pi/3 for any

@@ -34,12 +34,16 @@ def no_stage(name: str) -> AbstractContextManager[object]:
     return contextlib.nullcontext()
 
 
-def environment() -> jinja2.Environment:
-    """Strict Jinja2: an undefined name is an error, whitespace is the template's own."""
+def environment(template_dirs: Sequence[Path] = ()) -> jinja2.Environment:
+    """Strict Jinja2: an undefined name is an error, whitespace is the template's own.
+
+    Templates are found in the engine's folder, then in ``template_dirs`` (a robot's own, for
+    the bodies of hand-written kernels).
+    """
     from rpr3gen_derive.codegen.backends.c import comment
 
     env = jinja2.Environment(
-        loader=jinja2.FileSystemLoader(ENGINE_DIR),
+        loader=jinja2.FileSystemLoader([ENGINE_DIR, *template_dirs]),
         undefined=jinja2.StrictUndefined,
         trim_blocks=True,
         lstrip_blocks=True,
@@ -73,6 +77,8 @@ class Compiled:
 def compile_function(spec: FunctionSpec, params: Argument) -> Compiled:
     """Eliminate common subexpressions of ``spec`` and record which inputs it reads."""
     flat = spec.flat_outputs()
+    if spec.c_body is not None:  # a hand-written kernel body: nothing to eliminate
+        return Compiled(spec, StraightLine((), (), 0, 0), (), (), tuple((o, k) for o, k, _ in flat))
     code = straight_line(spec.program, [(f"{o}[{k}]", e) for o, k, e in flat])
     used = set().union(*(rhs.free_symbols for _, rhs in code.assignments + code.outputs))
     names = {str(s) for s in used}
@@ -120,7 +126,7 @@ def manifest(module: ModuleSpec, digest: str, files: dict[str, str]) -> str:
                 "name": f.name,
                 "c_symbol": f"{prefix}_{f.name}",
                 "c_batch_symbol": f"{prefix}_{f.name}_batch",
-                "numpy_function": f"{prefix}_{f.name}",
+                "numpy_function": None if f.c_body else f"{prefix}_{f.name}",
                 "doc": f.doc,
                 "inputs": [
                     {"name": a.name, "doc": a.doc, "components": _components(a)} for a in f.inputs
@@ -158,17 +164,22 @@ class Generator:
     Args:
         hash_roots: folders whose ``*.py`` and ``*.jinja`` files the output is derived from (the
             engine's own folder is always included).
+        template_dirs: folders of the templates that specs name (``FunctionSpec.c_body``).
         package_doc: docstring of the generated package's ``__init__.py``.
         stage: timing hook, see the module docstring.
     """
 
     def __init__(
-        self, hash_roots: Sequence[Path], package_doc: str, stage: Stage = no_stage
+        self,
+        hash_roots: Sequence[Path],
+        package_doc: str,
+        stage: Stage = no_stage,
+        template_dirs: Sequence[Path] = (),
     ) -> None:
         self.hash_roots = (ENGINE_DIR, *hash_roots)
         self.package_doc = package_doc
         self.stage = stage
-        self.env = environment()
+        self.env = environment(template_dirs)
 
     def source_hash(self) -> str:
         return source_hash(self.hash_roots)

@@ -100,7 +100,7 @@ class Threshold:
         return float(self.literal)
 
 
-CheckKind = Literal["inputs_not_finite", "below", "outputs_not_finite"]
+CheckKind = Literal["inputs_not_finite", "below", "outputs_not_finite", "custom"]
 
 
 @dataclass(frozen=True)
@@ -113,6 +113,8 @@ class Check:
     expression (``guard=("conditioning", expr)``), which the engine gathers into the hidden output
     ``guards`` of the function.
     ``outputs_not_finite``: an output component is NaN or infinite.
+    ``custom``: a function with a hand-written C body (:attr:`FunctionSpec.c_body`) returns this
+    code when it fails.
 
     The batch functions report a failed sample as a row of NaN, so after the input check all the
     checks of a function must give the same code (:class:`ModuleSpec` enforces it).
@@ -128,7 +130,14 @@ class Check:
 
 @dataclass(frozen=True)
 class FunctionSpec:
-    """A generated function ``outputs = f(params, inputs)``, computed by ``program``."""
+    """A generated function ``outputs = f(params, inputs)``, computed by ``program``.
+
+    A function whose work is not a straight-line program (an iteration, a search) names instead
+    a template of its C kernel's body, ``c_body``, found in the robot's template folders and
+    rendered with ``c_context``; it may call the kernels of the functions before it. It has no
+    NumPy version (the runtime composes those from the others) and its outputs' expressions are
+    unused.
+    """
 
     name: str
     doc: str
@@ -136,6 +145,8 @@ class FunctionSpec:
     outputs: tuple[Output, ...]
     program: Program
     checks: tuple[Check, ...] = ()
+    c_body: str | None = None
+    c_context: tuple[tuple[str, object], ...] = ()
 
     def __post_init__(self) -> None:
         guards = [c.guard for c in self.checks if c.guard is not None]

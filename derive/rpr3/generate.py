@@ -24,7 +24,12 @@ function's signature, name tables, thresholds and return codes for the runtime.
 
 def generator(stage: Stage = no_stage) -> Generator:
     """The engine, set up for this robot's sources."""
-    return Generator(hash_roots=(ROBOT_DIR,), package_doc=PACKAGE_DOC, stage=stage)
+    return Generator(
+        hash_roots=(ROBOT_DIR,),
+        package_doc=PACKAGE_DOC,
+        stage=stage,
+        template_dirs=(ROBOT_DIR / "templates",),
+    )
 
 
 def render(

@@ -10,7 +10,6 @@ Adding a generated function is adding an entry here.
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
 from functools import cache
 
 import sympy as sp
@@ -25,124 +24,30 @@ from rpr3gen_derive.codegen.spec import (
     ReturnCode,
     Threshold,
 )
+from rpr3gen_derive.rpr3 import control
 from rpr3gen_derive.rpr3 import symbols as syms
-from rpr3gen_derive.rpr3.dynamics import leg_wrenches
-from rpr3gen_derive.rpr3.kinematics import leg_kinematics, platform_rotation, reach
+from rpr3gen_derive.rpr3.derivation import (
+    ACTUATIONS,
+    OUTPUT_DOCS,
+    OUTPUT_FAMILIES,
+    OUTPUT_NAMES,
+    PARAM_DOCS,
+    SAMPLE_OUTPUTS,
+    derive,
+)
 from rpr3gen_derive.rpr3.symbols import LEGS, PARAM_NAMES
-from rpr3gen_derive.rpr3.virtual_work import joint_loads
 
-ACTUATIONS: tuple[str, ...] = ("revolute", "prismatic")
-
-
-@dataclass(frozen=True)
-class OutputFamily:
-    """One output of docs/conventions.md, for each of the three legs."""
-
-    name: str
-    unit: str
-    meaning: str
-
-
-OUTPUT_FAMILIES: tuple[OutputFamily, ...] = (
-    OutputFamily("phi10", "rad", "cylinder rotation about z0 from the central configuration"),
-    OutputFamily("lambda21", "m", "piston displacement from the central configuration"),
-    OutputFamily("phi32", "rad", "platform rotation relative to the leg, phi - phi10"),
-    OutputFamily("omega10", "rad/s", "d(phi10)/dt"),
-    OutputFamily("v21", "m/s", "d(lambda21)/dt"),
-    OutputFamily("omega32", "rad/s", "d(phi32)/dt"),
-    OutputFamily("eps10", "rad/s^2", "d2(phi10)/dt2"),
-    OutputFamily("gamma21", "m/s^2", "d2(lambda21)/dt2"),
-    OutputFamily("eps32", "rad/s^2", "d2(phi32)/dt2"),
-    OutputFamily("m10", "N m", "torque of the base on the cylinder at A1 about +z0 (motor)"),
-    OutputFamily("f10x", "N", "force of the base on the cylinder at A1, along x0"),
-    OutputFamily("f10y", "N", "force of the base on the cylinder at A1, along y0"),
-    OutputFamily("f21y", "N", "force of the cylinder on the piston, along y2 = n"),
-    OutputFamily("f21z", "N", "force of the cylinder on the piston, along z2 = e (actuator)"),
-    OutputFamily("m21", "N m", "moment of the cylinder on the piston about A2, along x2 = -z0"),
-    OutputFamily("f32y", "N", "force of the piston on the platform at A3, along y2 = n"),
-    OutputFamily("f32z", "N", "force of the piston on the platform at A3, along z2 = e"),
-)
-
-#: Outputs that are one per sample, not per leg.
-SAMPLE_OUTPUTS: tuple[OutputFamily, ...] = (
-    OutputFamily(
-        "conditioning",
-        "1",
-        "closeness to a parallel singularity, 0 (singular) to 1 (see virtual_work.conditioning)",
-    ),
-    OutputFamily(
-        "reach",
-        "1",
-        "min over legs of (l0 + lambda21) / l0: 1 central, <= 0 with a piston joint on or behind "
-        "its base pivot (see kinematics.reach)",
-    ),
-)
-
-OUTPUT_NAMES: tuple[str, ...] = tuple(
-    f"{f.name}_{leg}" for f in OUTPUT_FAMILIES for leg in LEGS
-) + tuple(f.name for f in SAMPLE_OUTPUTS)
-
-
-def _param_doc(name: str) -> tuple[str, str]:
-    """Unit and meaning of a model parameter (docs/interfaces.md)."""
-    fixed = {
-        "l0": ("m", "|A1A2| = l0 + lambda21"),
-        "l2": ("m", "|A2A3|"),
-        "c1": ("m", "cylinder centre of mass at A1 + c1 e"),
-        "c2": ("m", "piston centre of mass at A2 + c2 e"),
-        "m1": ("kg", "cylinder mass"),
-        "m2": ("kg", "piston mass"),
-        "m3": ("kg", "platform mass"),
-        "J1": ("kg m^2", "cylinder inertia about its centre of mass, axis z"),
-        "J2": ("kg m^2", "piston inertia about its centre of mass, axis z"),
-        "J3": ("kg m^2", "platform inertia about G, axis z"),
-        "gx": ("m/s^2", "gravity, world x0"),
-        "gy": ("m/s^2", "gravity, world y0 (up)"),
-        "fx": ("N", "payload force on the platform at G, x0"),
-        "fy": ("N", "payload force on the platform at G, y0"),
-        "mz": ("N m", "payload moment on the platform, about z0"),
-    }
-    if name in fixed:
-        return fixed[name]
-    if name.startswith("alpha_"):
-        return "rad", f"leg {name[-1]} angle where phi10 = 0"
-    axis, leg, point = name[0], name[1], name[2]
-    if point == "1":
-        return "m", f"base pivot {leg}1, world {axis}0"
-    return "m", f"platform joint {leg}3, platform frame {axis}G"
-
-
-PARAM_DOCS: tuple[tuple[str, str, str], ...] = tuple(
-    (name, *_param_doc(name)) for name in PARAM_NAMES
-)
-OUTPUT_DOCS: tuple[tuple[str, str, str], ...] = tuple(
-    (f"{f.name}_{leg}", f.unit, f.meaning) for f in OUTPUT_FAMILIES for leg in LEGS
-) + tuple((f.name, f.unit, f.meaning) for f in SAMPLE_OUTPUTS)
-
-
-def derive(actuation: str) -> tuple[Program, dict[str, sp.Expr]]:
-    """Run the paper's algorithm (steps 1-9) symbolically; return the program and outputs."""
-    if actuation not in ACTUATIONS:
-        raise ValueError(f"actuation must be one of {ACTUATIONS}, got {actuation!r}")
-    prog = Program()
-    cos_phi, sin_phi = platform_rotation(prog)
-    kinematics = {leg: leg_kinematics(prog, leg, cos_phi, sin_phi) for leg in LEGS}
-    wrenches = {
-        leg: leg_wrenches(prog, kinematics[leg], carries_platform=(leg == LEGS[0])) for leg in LEGS
-    }
-    loads = joint_loads(prog, actuation, kinematics, wrenches)
-    values: dict[str, sp.Expr] = {}
-    for leg, kin in kinematics.items():
-        for name in ("phi10", "lambda21", "phi32", "omega10", "v21", "omega32"):
-            values[f"{name}_{leg}"] = getattr(kin, name)
-        for name in ("eps10", "gamma21", "eps32"):
-            values[f"{name}_{leg}"] = getattr(kin, name)
-    values.update(loads)
-    values["reach"] = reach(prog, kinematics)
-    for name in OUTPUT_NAMES:  # the load of the free joint: m10 or f21z, identically zero
-        values.setdefault(name, sp.Integer(0))
-    return prog, {name: values[name] for name in OUTPUT_NAMES}
-
+__all__ = [
+    "ACTUATIONS",
+    "FUNCTIONS",
+    "OUTPUT_FAMILIES",
+    "OUTPUT_NAMES",
+    "PARAM_NAMES",
+    "SAMPLE_OUTPUTS",
+    "clear_cache",
+    "derive",
+    "module",
+]
 
 PREFIX = "rpr3"
 
@@ -186,6 +91,7 @@ RETURN_CODES: tuple[ReturnCode, ...] = (
         "singular or degenerate pose: a piston joint on or behind its base pivot (reach below "
         "MIN_REACH), conditioning below MIN_CONDITIONING, or a result that would not be finite",
     ),
+    ReturnCode("NO_MODE", 3, "no assembly mode for these actuator coordinates"),
 )
 
 THRESHOLDS: tuple[Threshold, ...] = (
@@ -243,14 +149,333 @@ def inverse_dynamics(actuation: str) -> FunctionSpec:
     )
 
 
-FunctionBuilder = Callable[[str], FunctionSpec]
+# -- the control model: actuator coordinates, Jacobian, task-space and forward dynamics, FK ----
 
-#: Every generated function, by name: a builder from the actuation scheme to its spec.
-FUNCTIONS: Mapping[str, FunctionBuilder] = {"inverse_dynamics": inverse_dynamics}
+
+def actuator_argument(actuation: str) -> Argument:
+    """``qa``: the actuator coordinates (docs/interfaces.md, "Control model")."""
+    family = control.ACTUATORS[actuation].coordinate
+    unit = "rad" if actuation == "revolute" else "m"
+    meaning = "cylinder rotation" if actuation == "revolute" else "piston displacement"
+    return Argument(
+        "qa",
+        tuple(control.qa),
+        tuple(Component(f"{family}_{leg}", unit, f"{meaning}, leg {leg}") for leg in LEGS),
+        f"actuator coordinates ({family}_A, _B, _C, from the central configuration)",
+    )
+
+
+def effort_argument(actuation: str) -> Argument:
+    """``tau``: the actuator efforts."""
+    family = control.ACTUATORS[actuation].effort
+    unit = "N m" if actuation == "revolute" else "N"
+    return Argument(
+        "tau",
+        tuple(control.tau),
+        tuple(Component(f"{family}_{leg}", unit, f"actuator effort, leg {leg}") for leg in LEGS),
+        f"actuator efforts ({family}_A, _B, _C)",
+    )
+
+
+def _pose_checks(prog: Program, actuation: str) -> tuple[Check, ...]:
+    """The failure conditions of the inverse dynamics, on the same values, as guards."""
+    outputs = control.include_inverse_dynamics(prog, actuation).outputs
+    return (
+        Check("inputs_not_finite", "NOT_FINITE"),
+        Check("below", "SINGULAR", threshold="MIN_REACH", guard=("reach", outputs["reach"])),
+        Check(
+            "below",
+            "SINGULAR",
+            threshold="MIN_CONDITIONING",
+            guard=("conditioning", outputs["conditioning"]),
+        ),
+        Check("outputs_not_finite", "SINGULAR"),
+    )
+
+
+def _matrix(name: str, m: sp.Matrix, units: tuple[str, ...], meaning: str) -> Output:
+    return Output(
+        name,
+        tuple(m[i, j] for i in range(3) for j in range(3)),
+        tuple(
+            Component(f"{name}{i + 1}{j + 1}", units[j] if len(units) == 3 else units[3 * i + j])
+            for i in range(3)
+            for j in range(3)
+        ),
+        meaning,
+    )
+
+
+def _triple(name: str, v: sp.Matrix, names: tuple[str, ...], units: tuple[str, ...], doc: str):
+    return Output(
+        name,
+        tuple(v[k] for k in range(3)),
+        tuple(Component(n, u) for n, u in zip(names, units, strict=True)),
+        doc,
+    )
+
+
+def _rate_units(actuation: str, per: str) -> tuple[str, ...]:
+    unit = "rad" if actuation == "revolute" else "m"
+    return (f"{unit}/{per}",) * 3
+
+
+def actuator_coordinates(actuation: str) -> FunctionSpec:
+    """``rpr3_actuator_coordinates``: ``qa`` of a pose, the inverse kinematics of eq. (5)."""
+    prog = Program()
+    derivation = control.include_inverse_dynamics(prog, actuation)
+    family = control.ACTUATORS[actuation].coordinate
+    values = sp.Matrix([derivation.outputs[f"{family}_{leg}"] for leg in LEGS])
+    qa = actuator_argument(actuation)
+    return FunctionSpec(
+        name="actuator_coordinates",
+        doc=f"Actuator coordinates qa = ({family}_A, _B, _C) of the platform pose q (eq. 5).",
+        inputs=(POSE,),
+        outputs=(
+            _triple(
+                "qa",
+                values,
+                tuple(c.name for c in qa.components),
+                (qa.components[0].unit,) * 3,
+                qa.doc,
+            ),
+        ),
+        program=prog,
+        checks=_pose_checks(prog, actuation),
+    )
+
+
+def actuator_jacobian(actuation: str) -> FunctionSpec:
+    """``rpr3_actuator_jacobian``: ``J = d qa / d q``, row-major, so that ``qa' = J q'``."""
+    prog = Program()
+    J = control.actuator_jacobian(prog, actuation)
+    units = ("1/m", "1/m", "1") if actuation == "revolute" else ("1", "1", "m")
+    return FunctionSpec(
+        name="actuator_jacobian",
+        doc="Actuator Jacobian J = d qa / d q (eq. 6 differentiated), row-major, one row per "
+        "leg A, B, C: qa' = J q'. det J = 0 at a parallel singularity.",
+        inputs=(POSE,),
+        outputs=(_matrix("J", J, units, "J = d qa / d q, row-major"),),
+        program=prog,
+        checks=_pose_checks(prog, actuation),
+    )
+
+
+def jacobian_rate(actuation: str) -> FunctionSpec:
+    """``rpr3_jacobian_rate``: ``J' q'``, so that ``qa'' = J q'' + J' q'`` (eq. 9)."""
+    prog = Program()
+    rate = control.jacobian_rate_term(prog, actuation)
+    qa = actuator_argument(actuation)
+    return FunctionSpec(
+        name="jacobian_rate",
+        doc="J' q': the actuator accelerations at zero platform acceleration (eq. 9), so that "
+        "qa'' = J q'' + J' q'.",
+        inputs=(POSE, VELOCITY),
+        outputs=(
+            _triple(
+                "Jdqd",
+                rate,
+                tuple(f"dd{c.name}" for c in qa.components),
+                _rate_units(actuation, "s^2"),
+                "J' q'",
+            ),
+        ),
+        program=prog,
+        checks=_pose_checks(prog, actuation),
+    )
+
+
+def task_space_dynamics(actuation: str) -> FunctionSpec:
+    """``rpr3_task_space_dynamics``: ``M`` (row-major) and ``c`` with ``M q'' + c = J^T tau``."""
+    prog = Program()
+    M, c = control.task_space_dynamics(prog, actuation)
+    return FunctionSpec(
+        name="task_space_dynamics",
+        doc="Dynamics in control form, M q'' + c = J^T tau, from the virtual work of the "
+        "required wrenches of eqs. (10)-(17): M (row-major, symmetric positive definite) and c "
+        "(Coriolis and centripetal terms, gravity, payload).",
+        inputs=(POSE, VELOCITY),
+        outputs=(
+            _matrix(
+                "M",
+                M,
+                ("kg", "kg", "kg m", "kg", "kg", "kg m", "kg m", "kg m", "kg m^2"),
+                "mass matrix in platform coordinates, row-major",
+            ),
+            _triple("c", c, ("c_x", "c_y", "c_phi"), ("N", "N", "N m"), "bias forces"),
+        ),
+        program=prog,
+        checks=_pose_checks(prog, actuation),
+    )
+
+
+def forward_dynamics(actuation: str) -> FunctionSpec:
+    """``rpr3_forward_dynamics``: ``q'' = M^-1 (J^T tau - c)``, by an LDL^T solve."""
+    prog = Program()
+    qdd = control.forward_dynamics(prog, actuation)
+    return FunctionSpec(
+        name="forward_dynamics",
+        doc="Forward dynamics: the platform acceleration q'' = M^-1 (J^T tau - c) under the "
+        "actuator efforts tau, by an explicit LDL^T solve of the task-space dynamics.",
+        inputs=(POSE, VELOCITY, effort_argument(actuation)),
+        outputs=(
+            _triple(
+                "qdd",
+                qdd,
+                tuple(c.name for c in ACCELERATION.components),
+                tuple(c.unit for c in ACCELERATION.components),
+                "platform acceleration",
+            ),
+        ),
+        program=prog,
+        checks=_pose_checks(prog, actuation),
+    )
+
+
+def assembly_modes(actuation: str) -> FunctionSpec:
+    """``rpr3_assembly_modes``: the direct kinematics' closed forms.
+
+    Revolute actuation: both modes (x, y, phi) and their margins (a mode exists where its
+    margin is >= 0). Prismatic: the coefficients of the sextic in tan(phi/2), whose real roots
+    :func:`pose_from_angle` turns into poses.
+    """
+    prog = Program()
+    qa = actuator_argument(actuation)
+    checks = (Check("inputs_not_finite", "NOT_FINITE"),)
+    if actuation == "revolute":
+        modes = control.assembly_modes_revolute(prog)
+        return FunctionSpec(
+            name="assembly_modes",
+            doc="Both assembly modes of the actuator angles qa, in closed form: the closure "
+            "reduces to A cos(phi) + B sin(phi) + C = 0. A mode exists where its margin >= 0.",
+            inputs=(qa,),
+            outputs=(
+                Output(
+                    "modes",
+                    tuple(getattr(m, k) for m in modes for k in ("x", "y", "phi")),
+                    tuple(
+                        Component(f"{k}{i + 1}", u)
+                        for i in range(2)
+                        for k, u in (("x", "m"), ("y", "m"), ("phi", "rad"))
+                    ),
+                    "the two modes (x, y, phi), phi in [-pi, pi]",
+                ),
+                Output(
+                    "margins",
+                    tuple(m.margin for m in modes),
+                    (Component("margin1"), Component("margin2")),
+                    "a mode exists where its margin is >= 0",
+                ),
+            ),
+            program=prog,
+            checks=checks,
+        )
+    coefficients = control.sextic_coefficients(prog)
+    return FunctionSpec(
+        name="assembly_modes",
+        doc="The direct kinematics of the piston displacements qa as a polynomial: coefficients "
+        "a0..a6 of sum a_j t^j = 0, t = tan(phi/2) (Gosselin; Merlet), whose real roots give "
+        "every assembly mode (then pose_from_angle).",
+        inputs=(qa,),
+        outputs=(
+            Output(
+                "a",
+                tuple(coefficients),
+                tuple(Component(f"a{j}") for j in range(7)),
+                "coefficients of t^0 .. t^6",
+            ),
+        ),
+        program=prog,
+        checks=checks,
+    )
+
+
+ANGLE = Argument(
+    "angle",
+    (sp.Symbol("cos_phi_in", real=True), sp.Symbol("sin_phi_in", real=True)),
+    (Component("cos_phi"), Component("sin_phi")),
+    "cosine and sine of the platform angle",
+)
+
+
+def pose_from_angle(actuation: str) -> FunctionSpec | None:
+    """``rpr3_pose_from_angle`` (prismatic actuation): G for a root phi of the sextic."""
+    if actuation != "prismatic":
+        return None
+    prog = Program()
+    x, y = control.pose_from_angle(prog, *ANGLE.symbols)
+    return FunctionSpec(
+        name="pose_from_angle",
+        doc="Position of G for a platform angle phi that solves the direct kinematics of the "
+        "piston displacements qa (back substitution of the sextic's root).",
+        inputs=(actuator_argument(actuation), ANGLE),
+        outputs=(Output("xy", (x, y), (Component("x", "m"), Component("y", "m")), "G"),),
+        program=prog,
+        checks=(Check("inputs_not_finite", "NOT_FINITE"),),
+    )
+
+
+def forward_kinematics(actuation: str) -> FunctionSpec:
+    """``rpr3_forward_kinematics``: the assembly mode of ``qa`` nearest a reference pose.
+
+    Damped Newton on ``qa(q) = qa`` from ``q_near`` with the generated Jacobian; when it does not
+    converge, leaves the reference's aspect or gives a leg of no length, every mode (closed form,
+    or the sextic's roots found by sampling and bisection) and the nearest in ``(x, y, rho phi)``.
+    C only (``templates/forward_kinematics.c.jinja``); Python composes the same from
+    ``assembly_modes`` and ``pose_from_angle``.
+    """
+    qa = actuator_argument(actuation)
+    near = Argument(
+        "q_near",
+        tuple(sp.Symbol(f"{c.name}_near", real=True) for c in POSE.components),
+        tuple(Component(c.name, c.unit, c.meaning) for c in POSE.components),
+        "the reference pose: the previous solution, or better a prediction from the last two",
+    )
+    return FunctionSpec(
+        name="forward_kinematics",
+        doc="Tracked forward kinematics: the assembly mode of the actuator coordinates qa "
+        "nearest the reference pose q_near (distance in (x, y, rho phi), rho the platform's "
+        "RMS joint radius), phi unwrapped next to q_near's. Damped Newton with the generated "
+        "Jacobian; when it fails, every mode and the nearest. RPR3_NO_MODE when there is none.",
+        inputs=(qa, near),
+        outputs=(
+            Output(
+                "q",
+                (sp.Integer(0),) * 3,
+                POSE.components,
+                "the pose found",
+            ),
+        ),
+        program=Program(),
+        checks=(Check("inputs_not_finite", "NOT_FINITE"), Check("custom", "NO_MODE")),
+        c_body="forward_kinematics.c.jinja",
+        c_context=(
+            ("actuation", actuation),
+            ("max_modes", control.MAX_MODES[actuation]),
+            ("length_tol", repr(control.LENGTH_TOL)),
+        ),
+    )
+
+
+FunctionBuilder = Callable[[str], FunctionSpec | None]
+
+#: Every generated function, by name: a builder from the actuation scheme to its spec. A builder
+#: may return None for a variant that has no such function.
+FUNCTIONS: Mapping[str, FunctionBuilder] = {
+    "inverse_dynamics": inverse_dynamics,
+    "actuator_coordinates": actuator_coordinates,
+    "actuator_jacobian": actuator_jacobian,
+    "jacobian_rate": jacobian_rate,
+    "task_space_dynamics": task_space_dynamics,
+    "forward_dynamics": forward_dynamics,
+    "assembly_modes": assembly_modes,
+    "pose_from_angle": pose_from_angle,
+    "forward_kinematics": forward_kinematics,
+}
 
 
 @cache
-def _spec(builder: FunctionBuilder, actuation: str) -> FunctionSpec:
+def _spec(builder: FunctionBuilder, actuation: str) -> FunctionSpec | None:
     return builder(actuation)
 
 
@@ -273,8 +498,15 @@ def module(actuation: str, functions: Mapping[str, FunctionBuilder] | None = Non
             "this structure."
         ),
         params=PARAMS,
-        functions=tuple(_spec(builder, actuation) for builder in functions.values()),
+        functions=tuple(
+            spec
+            for builder in functions.values()
+            if (spec := _spec(builder, actuation)) is not None
+        ),
         return_codes=RETURN_CODES,
         thresholds=THRESHOLDS,
-        defines=(("ACTUATION", f'"{actuation}"', ""),),
+        defines=(
+            ("ACTUATION", f'"{actuation}"', ""),
+            ("MAX_MODES", str(control.MAX_MODES[actuation]), "most assembly modes of one qa"),
+        ),
     )

@@ -11,7 +11,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 import jinja2
-from rpr3gen_derive.codegen.backends.c.batch import plan
+from rpr3gen_derive.codegen.backends.c.batch import NotSplittableError, plan
 from rpr3gen_derive.codegen.backends.c.printer import c_code
 from rpr3gen_derive.codegen.spec import ModuleSpec
 
@@ -56,7 +56,10 @@ def _function(module: ModuleSpec, c: Compiled) -> dict[str, Any]:
     prefix, spec = module.prefix, c.spec
     upper = prefix.upper()
     params = {s for s in module.params.symbols if any(str(s) == n for _, n in c.used_params)}
-    p = plan(c.code, c.input_symbols, params)
+    try:
+        p = None if spec.c_body else plan(c.code, c.input_symbols, params)
+    except NotSplittableError:  # the batch loops over the kernel instead
+        p = None
     slot = dict(enumerate(c.slots))
 
     def outputs(indexed: Any) -> list[tuple[str, int, str]]:
@@ -77,6 +80,7 @@ def _function(module: ModuleSpec, c: Compiled) -> dict[str, Any]:
     kernel += [f"double *restrict r_{o.name}" for o in spec.outputs]
     checks = []
     input_code = None
+    custom_code = None
     for check in spec.checks:
         code = f"{upper}_{check.code}"
         if check.kind == "inputs_not_finite":
@@ -93,8 +97,10 @@ def _function(module: ModuleSpec, c: Compiled) -> dict[str, Any]:
                     "threshold": f"{upper}_{check.threshold}",
                 }
             )
-        else:
+        elif check.kind == "outputs_not_finite":
             checks.append({"kind": check.kind, "code": code})
+        else:
+            custom_code = code
     return {
         "spec": spec,
         "name": name,
@@ -107,10 +113,15 @@ def _function(module: ModuleSpec, c: Compiled) -> dict[str, Any]:
         "assignments": _lines(c.code.assignments),
         "outputs": outputs(enumerate(e for _, e in c.code.outputs)),
         "input_code": input_code,
+        "custom_code": custom_code,
         "checks": checks,
+        "body": spec.c_body,
+        "context": dict(spec.c_context),
         "ops_before": c.code.ops_before,
         "ops_after": c.code.ops_after,
-        "batch": {
+        "batch": None
+        if p is None
+        else {
             "constants": _lines(p.constants),
             "pass_a": _lines(p.pass_a),
             "pass_b": _lines(p.pass_b),

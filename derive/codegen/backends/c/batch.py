@@ -32,6 +32,10 @@ def calls_libm(expr: sp.Expr) -> bool:
     return False
 
 
+class NotSplittableError(ValueError):
+    """The program does not fit the three passes: its batch calls the single-sample kernel."""
+
+
 @dataclass(frozen=True)
 class BatchPlan:
     """Which statement runs in which pass, and which values cross between passes."""
@@ -85,7 +89,9 @@ def plan(code: StraightLine, inputs: set[sp.Symbol], params: set[sp.Symbol]) -> 
             users.setdefault(s, set()).add(lhs)
     for s in late:
         if users.get(s):
-            raise ValueError(f"late call {s} is used by other statements: {users[s]}")
+            raise NotSplittableError(
+                f"late call {s} is used by other statements: {sorted(map(str, users[s]))}"
+            )
     order = [lhs for lhs, _ in statements if lhs not in scalar]
     pass_a = tuple((s, rhs_of[s]) for s in order if s in early)
     pass_c = tuple((s, rhs_of[s]) for s in order if s in late)

@@ -29,6 +29,8 @@ def render(
     functions = []
     with stage("print"):
         for c in compiled:
+            if c.spec.c_body is not None:  # C only: the runtime composes it from the others
+                continue
             inputs = {s: str(s) for arg in c.spec.inputs for s in arg.symbols}
             params = {
                 s for s in module.params.symbols if any(str(s) == n for _, n in c.used_params)

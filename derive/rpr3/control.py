@@ -1,7 +1,7 @@
 """The control model of the 3-RPR robot: actuator Jacobian, task-space dynamics, forward kinematics.
 
-Everything here appends named assignments to a :class:`~rpr3gen_derive.symbols.Program`, as the
-inverse dynamics does, so that the code-generation engine can turn it into NumPy and C functions.
+Everything here appends named assignments to a :class:`~rpr3gen_derive.codegen.program.Program`,
+as the inverse dynamics does, so that the code-generation engine can turn it into NumPy and C.
 
 - Actuator coordinates ``qa`` (:data:`qa`): ``phi10_A..C`` (revolute actuation) or
   ``lambda21_A..C`` (prismatic), measured from the central configuration; actuator efforts
@@ -14,8 +14,10 @@ inverse dynamics does, so that the code-generation engine can turn it into NumPy
 - :func:`assembly_modes_revolute` (closed form, at most 2 modes), :func:`sextic_coefficients`
   and :func:`pose_from_angle` (prismatic actuation, at most 6 modes): the direct kinematics.
 
-The numeric side (all modes from the sextic, tracked Newton FK) is in ``fk_tracking``, which
-needs only NumPy. See ``CONTROL_NOTES.md`` for the mathematics and the operation counts.
+The numeric side (all modes from the sextic, tracked Newton FK) is in the runtime
+(``src/rpr3gen/control.py``) and the generated C (``templates/forward_kinematics.c.jinja``); its
+NumPy prototype is ``tests/fk_reference.py``. See ``docs/control-model.md`` for the mathematics
+and the operation counts.
 """
 
 from __future__ import annotations
@@ -26,13 +28,14 @@ from functools import cache
 from typing import NamedTuple
 
 import sympy as sp
-from rpr3gen_derive import symbols as syms
-from rpr3gen_derive.dynamics import BodyMotion, LegWrenches, leg_wrenches, required_wrench
-from rpr3gen_derive.frames import u3
-from rpr3gen_derive.kinematics import LegKinematics, leg_kinematics, platform_rotation
-from rpr3gen_derive.specs import ACTUATIONS, FunctionSpec, derive
-from rpr3gen_derive.symbols import LEGS, PARAM_NAMES, Program
-from rpr3gen_derive.virtual_work import platform_radius_squared
+from rpr3gen_derive.codegen.program import Program
+from rpr3gen_derive.rpr3 import symbols as syms
+from rpr3gen_derive.rpr3.derivation import ACTUATIONS, derive
+from rpr3gen_derive.rpr3.dynamics import BodyMotion, LegWrenches, leg_wrenches, required_wrench
+from rpr3gen_derive.rpr3.frames import u3
+from rpr3gen_derive.rpr3.kinematics import LegKinematics, leg_kinematics, platform_rotation
+from rpr3gen_derive.rpr3.symbols import LEGS, PARAM_NAMES
+from rpr3gen_derive.rpr3.virtual_work import platform_radius_squared
 
 STEP_JACOBIAN = "actuator Jacobian, d qa / d q, from eq. (6)"
 STEP_RATE = "actuator accelerations at zero platform acceleration, eq. (9)"
@@ -552,12 +555,17 @@ def _dot(a: tuple[sp.Expr, sp.Expr], b: tuple[sp.Expr, sp.Expr]) -> sp.Expr:
 
 
 class Mode(NamedTuple):
-    """One assembly mode ``(x, y, phi, valid)``: the pose, and whether it exists (a Boolean)."""
+    """One assembly mode ``(x, y, phi, margin)``: the pose, and ``margin >= 0`` where it exists.
+
+    ``margin`` is the smallest of the quantities whose signs decide existence (the discriminant,
+    the degeneracy tests and the leg lengths, each minus its tolerance), so that the generated
+    code returns a number where SymPy would say True or False.
+    """
 
     x: sp.Expr
     y: sp.Expr
     phi: sp.Expr
-    valid: sp.Boolean
+    margin: sp.Expr
 
 
 def assembly_modes_revolute(prog: Program) -> list[Mode]:
@@ -636,13 +644,17 @@ def assembly_modes_revolute(prog: Program) -> list[Mode]:
                 y + sin_phi * p[0] + cos_phi * p[1] - a1[1],
             )
             lengths.append(bld.define(f"fk{m}_length_{leg}", _dot(e[leg], d), step))
-        valid = sp.And(
-            sp.GreaterThan(disc, 0),
-            sp.StrictGreaterThan(ab2, DEGENERACY_TOL**2 * ksq * platform_radius_squared()),
-            sp.StrictGreaterThan(ksq, DEGENERACY_TOL**2),
-            *(sp.StrictGreaterThan(length, LENGTH_TOL * min_length) for length in lengths),
+        margin = bld.define(
+            f"fk{m}_margin",
+            sp.Min(
+                disc,
+                ab2 - DEGENERACY_TOL**2 * ksq * platform_radius_squared(),
+                ksq - DEGENERACY_TOL**2,
+                *(length - LENGTH_TOL * min_length for length in lengths),
+            ),
+            step,
         )
-        modes.append(Mode(x, y, phi, valid))
+        modes.append(Mode(x, y, phi, margin))
     return modes
 
 
@@ -810,101 +822,3 @@ def pose_from_angle(prog: Program, cos_phi: sp.Expr, sin_phi: sp.Expr) -> tuple[
 def platform_rms_radius() -> sp.Expr:
     """``rho = sqrt(mean |p_i|^2)`` (m): the length that turns ``phi`` into a distance."""
     return sp.sqrt(platform_radius_squared())
-
-
-# ----------------------------------------------------------------------------------------------
-# Function specs for the code-generation engine.
-
-
-def _spec(
-    name: str,
-    actuation: str,
-    inputs: tuple[tuple[str, tuple[sp.Symbol, ...]], ...],
-    prog: Program,
-    outputs: Sequence[tuple[str, sp.Expr]],
-    doc: str,
-) -> FunctionSpec:
-    return FunctionSpec(
-        name=name,
-        actuation=actuation,
-        param_names=PARAM_NAMES,
-        inputs=inputs,
-        program=prog,
-        outputs=tuple(outputs),
-        docstring=doc,
-    )
-
-
-def _matrix_outputs(name: str, m: sp.Matrix) -> list[tuple[str, sp.Expr]]:
-    return [(f"{name}{i + 1}{j + 1}", m[i, j]) for i in range(m.rows) for j in range(m.cols)]
-
-
-def control_specs(actuation: str) -> dict[str, FunctionSpec]:
-    """One :class:`FunctionSpec` per control-model function, for the engine (and op counts).
-
-    Each spec has its own program, so that its op count is its own: ``actuator_jacobian``
-    (q -> J, row-major), ``jacobian_rate`` (q, qd -> J' q'), ``task_space_dynamics``
-    (q, qd -> M row-major, c), ``forward_dynamics`` (q, qd, tau -> qdd), and the direct
-    kinematics: ``assembly_modes`` (qa -> two modes x, y, phi) for revolute actuation, or
-    ``sextic`` (qa -> a0..a6) and ``pose_from_angle`` (qa, cos, sin -> x, y) for prismatic.
-    """
-    q_in = ("q", tuple(syms.q))
-    qd_in = ("qd", tuple(syms.qd))
-    specs: dict[str, FunctionSpec] = {}
-
-    prog = Program()
-    J = actuator_jacobian(prog, actuation)
-    specs["actuator_jacobian"] = _spec(
-        "rpr3_actuator_jacobian", actuation, (q_in,), prog, _matrix_outputs("J", J),
-        "Actuator Jacobian J = d qa / d q (row-major, one row per leg).",
-    )  # fmt: skip
-    prog = Program()
-    rate = jacobian_rate_term(prog, actuation)
-    specs["jacobian_rate"] = _spec(
-        "rpr3_jacobian_rate", actuation, (q_in, qd_in), prog,
-        [(f"Jdqd{k + 1}", rate[k]) for k in range(3)],
-        "J' q': actuator accelerations at zero platform acceleration.",
-    )  # fmt: skip
-    prog = Program()
-    M, c = task_space_dynamics(prog, actuation)
-    specs["task_space_dynamics"] = _spec(
-        "rpr3_task_space_dynamics", actuation, (q_in, qd_in), prog,
-        _matrix_outputs("M", M) + [(f"c{k + 1}", c[k]) for k in range(3)],
-        "Task-space dynamics M q'' + c = J^T tau (M row-major, symmetric).",
-    )  # fmt: skip
-    prog = Program()
-    qdd = forward_dynamics(prog, actuation)
-    specs["forward_dynamics"] = _spec(
-        "rpr3_forward_dynamics", actuation, (q_in, qd_in, ("tau", tuple(tau))), prog,
-        [(f"qdd{k + 1}", qdd[k]) for k in range(3)],
-        "Forward dynamics q'' = M^-1 (J^T tau - c).",
-    )  # fmt: skip
-    qa_in = ("qa", tuple(qa))
-    prog = Program()
-    if actuation == "revolute":
-        modes = assembly_modes_revolute(prog)
-        outputs = [
-            (f"{name}{m + 1}", getattr(mode, name))
-            for m, mode in enumerate(modes)
-            for name in ("x", "y", "phi")
-        ]
-        specs["assembly_modes"] = _spec(
-            "rpr3_assembly_modes", actuation, (qa_in,), prog, outputs,
-            "Both assembly modes (x, y, phi) of revolute actuation, closed form.",
-        )  # fmt: skip
-    else:
-        coefficients = sextic_coefficients(prog)
-        specs["sextic"] = _spec(
-            "rpr3_sextic", actuation, (qa_in,), prog,
-            [(f"a{k}", a) for k, a in enumerate(coefficients)],
-            "Coefficients a0..a6 of the direct-kinematics sextic in tan(phi/2).",
-        )  # fmt: skip
-        prog = Program()
-        angle = (sp.Symbol("cos_phi_in", real=True), sp.Symbol("sin_phi_in", real=True))
-        x, y = pose_from_angle(prog, *angle)
-        specs["pose_from_angle"] = _spec(
-            "rpr3_pose_from_angle", actuation, (qa_in, ("angle", angle)), prog,
-            [("x", x), ("y", y)],
-            "Position of G for a root phi of the sextic (back substitution).",
-        )  # fmt: skip
-    return specs
