@@ -15,6 +15,17 @@ regeneration lives in the package ``rpr3gen_derive`` (folder ``derive/``) and wr
 import importlib.metadata
 
 from rpr3gen.backends import BACKENDS, OUTPUT_NAMES, evaluate, inverse_dynamics
+from rpr3gen.control import (
+    actuator_coordinates,
+    actuator_jacobian,
+    assembly_modes,
+    forward_dynamics,
+    forward_kinematics,
+    jacobian_rate,
+    platform_radius,
+    platform_velocity,
+    task_space_dynamics,
+)
 from rpr3gen.errors import (
     InputError,
     InputTypeError,
@@ -48,9 +59,18 @@ __all__ = [
     "TrajectoryError",
     "TrajectoryWarning",
     "__version__",
+    "actuator_coordinates",
+    "actuator_jacobian",
+    "assembly_modes",
     "evaluate",
+    "forward_dynamics",
+    "forward_kinematics",
     "inverse_dynamics",
+    "jacobian_rate",
     "load_model",
     "paper_trajectory",
+    "platform_radius",
+    "platform_velocity",
     "read_trajectory_csv",
+    "task_space_dynamics",
 ]

@@ -160,6 +160,23 @@ def _parser() -> argparse.ArgumentParser:
     )
     par.add_argument("--model", metavar="FILE", help=f"model TOML file ({paper_model})")
 
+    fk = sub.add_parser(
+        "fk",
+        help="forward kinematics: every assembly mode of three actuator readings",
+        description="Print every assembly mode of the actuator coordinates QA1 QA2 QA3 (legs A, "
+        "B, C: phi10 in rad with revolute actuation, lambda21 in m with prismatic), one per "
+        "line: x y (m) phi (rad, in (-pi, pi]) and the pose's conditioning (0 = singular, 1 = "
+        "best).",
+    )
+    fk.add_argument("--model", metavar="FILE", help=f"model TOML file ({paper_model})")
+    fk.add_argument(
+        "--generated",
+        metavar="DIR",
+        help="use the generated code that `rpr3gen generate` wrote into DIR "
+        "(default: the installed generated package)",
+    )
+    fk.add_argument("qa", nargs=3, type=float, metavar="QA", help="actuator coordinate")
+
     gen = sub.add_parser("generate", help="derive and write the generated sources")
     gen.add_argument(
         "--model",
@@ -395,6 +412,26 @@ def _cmd_params(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_fk(args: argparse.Namespace) -> int:
+    from rpr3gen.control import assembly_modes
+
+    model = load_model(args.model, generated=args.generated)
+    qa = np.array(args.qa)
+    if not np.isfinite(qa).all():
+        raise InputError(f"QA: actuator coordinates must be finite, got {args.qa}")
+    modes = assembly_modes(model, qa)
+    zero = np.zeros_like(modes)
+    conditioning = inverse_dynamics(model, modes, zero, zero)["conditioning"] if len(modes) else []
+    family = "phi10" if model.actuation == "revolute" else "lambda21"
+    print(
+        f"# {len(modes)} assembly mode(s) of {family} = {' '.join(f'{v:g}' for v in qa)} "
+        f"({model.name}, {model.actuation} actuation): x y phi conditioning"
+    )
+    for mode, c in zip(modes, conditioning, strict=True):
+        print(f"{mode[0]:.12g} {mode[1]:.12g} {mode[2]:.12g} {c:.6g}")
+    return 0
+
+
 def _cmd_generate(args: argparse.Namespace) -> int:
     try:
         from rpr3gen_derive.codegen import files as codegen_files
@@ -436,6 +473,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         "simulate": _cmd_simulate,
         "paper": _cmd_paper,
         "params": _cmd_params,
+        "fk": _cmd_fk,
         "generate": _cmd_generate,
     }
     try:

@@ -83,6 +83,11 @@ class NumpyEvaluator:
         inputs: Sequence[np.ndarray],
         outputs: Sequence[np.ndarray],
     ) -> None:
+        if function.numpy_function is None:
+            raise InputError(
+                f"{function.name} has no NumPy version (its generated code is C only); "
+                "use backend='c'"
+            )
         call = getattr(self.module, function.numpy_function)
         call(params, *inputs, *(o.T for o in outputs))
 

@@ -57,7 +57,7 @@ class FunctionInfo:
     name: str
     c_symbol: str
     c_batch_symbol: str
-    numpy_function: str
+    numpy_function: str | None  # None: C only (a hand-written kernel body)
     doc: str
     inputs: tuple[ArgInfo, ...]
     outputs: tuple[ArgInfo, ...]  # the public ones first, then any hidden one
