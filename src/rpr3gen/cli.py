@@ -421,7 +421,9 @@ def _cmd_fk(args: argparse.Namespace) -> int:
         raise InputError(f"QA: actuator coordinates must be finite, got {args.qa}")
     modes = assembly_modes(model, qa)
     zero = np.zeros_like(modes)
-    conditioning = inverse_dynamics(model, modes, zero, zero)["conditioning"] if len(modes) else []
+    conditioning = (
+        inverse_dynamics(model, modes, zero, zero)["conditioning"] if len(modes) else zero
+    )
     family = "phi10" if model.actuation == "revolute" else "lambda21"
     print(
         f"# {len(modes)} assembly mode(s) of {family} = {' '.join(f'{v:g}' for v in qa)} "

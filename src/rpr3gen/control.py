@@ -174,22 +174,22 @@ def assembly_modes(model: Model, qa: ArrayLike, backend: str = "numpy") -> np.nd
     everywhere in rpr3gen, every piston joint in front of its base pivot (``reach`` above the
     generated ``MIN_REACH``); stroke limits are not applied.
     """
-    qa = samples("qa", qa, 3)[0]
+    row = samples("qa", qa, 3)[0]
     if model.actuation == "revolute":
-        (modes, margins), _ = evaluate(model, "assembly_modes", (qa,), backend)
+        (modes, margins), _ = evaluate(model, "assembly_modes", (row,), backend)
         found = modes.reshape(2, 3)[margins[0] >= 0]
     else:
-        (a,), _ = evaluate(model, "assembly_modes", (qa,), backend)
+        (a,), _ = evaluate(model, "assembly_modes", (row,), backend)
         angles = _sextic_angles(a[0])
         if not angles:
             return np.empty((0, 3))
         phi = np.array(angles)
         cos_sin = np.stack([np.cos(phi), np.sin(phi)], axis=1)
         (xy,), _ = evaluate(
-            model, "pose_from_angle", (np.tile(qa, (len(phi), 1)), cos_sin), backend
+            model, "pose_from_angle", (np.tile(row, (len(phi), 1)), cos_sin), backend
         )
         candidates = np.column_stack([xy, phi])
-        found = _polish(model, candidates, qa, backend)
+        found = _polish(model, candidates, row, backend)
     modes = _distinct(model, found)
     floor = manifest.load(model.actuation, model.generated).thresholds["MIN_REACH"]
     reach = leg_extensions(model, modes).min(axis=1) / model.params["l0"] if len(modes) else []
