@@ -193,12 +193,23 @@ def _pose_checks(prog: Program, actuation: str) -> tuple[Check, ...]:
     )
 
 
-def _matrix(name: str, m: sp.Matrix, units: tuple[str, ...], meaning: str) -> Output:
+def _matrix(
+    name: str,
+    m: sp.Matrix,
+    units: tuple[str, ...],
+    meaning: str,
+    entry: Callable[[int, int], str] = lambda i, j: "",
+) -> Output:
+    """A 3 x 3 matrix output, row-major; ``units`` per column (3) or per entry (9)."""
     return Output(
         name,
         tuple(m[i, j] for i in range(3) for j in range(3)),
         tuple(
-            Component(f"{name}{i + 1}{j + 1}", units[j] if len(units) == 3 else units[3 * i + j])
+            Component(
+                f"{name}{i + 1}{j + 1}",
+                units[j] if len(units) == 3 else units[3 * i + j],
+                entry(i, j),
+            )
             for i in range(3)
             for j in range(3)
         ),
@@ -250,12 +261,21 @@ def actuator_jacobian(actuation: str) -> FunctionSpec:
     prog = Program()
     J = control.actuator_jacobian(prog, actuation)
     units = ("1/m", "1/m", "1") if actuation == "revolute" else ("1", "1", "m")
+    qa_names = [c.name for c in actuator_argument(actuation).components]
     return FunctionSpec(
         name="actuator_jacobian",
         doc="Actuator Jacobian J = d qa / d q (eq. 6 differentiated), row-major, one row per "
         "leg A, B, C: qa' = J q'. det J = 0 at a parallel singularity.",
         inputs=(POSE,),
-        outputs=(_matrix("J", J, units, "J = d qa / d q, row-major"),),
+        outputs=(
+            _matrix(
+                "J",
+                J,
+                units,
+                "J = d qa / d q, row-major",
+                lambda i, j: f"d {qa_names[i]} / d {POSE.components[j].name}",
+            ),
+        ),
         program=prog,
         checks=_pose_checks(prog, actuation),
     )
