@@ -457,9 +457,17 @@ def _forward_kinematics_doc(actuation: str) -> str:
         f"{n['max_iter']} steps. (2) Its pose is returned when it converged, every leg has a "
         "positive length and det J has the sign it has at q_near (same aspect). (3) Otherwise "
         "(no convergence, a singular J, a failed line search, another aspect) the fallback: "
-        f"every mode, {modes}; the nearest wins. A reference that crosses a parallel "
-        "singularity should be a prediction (2 q[k-1] - q[k-2]), not the previous pose. "
-        "RPR3_NO_MODE, q untouched, when there is no mode. No allocation, no state."
+        f"every mode, {modes}; the nearest wins. RPR3_NO_MODE, q untouched, when there is no "
+        "mode. Limits: through a parallel singularity only a predicted reference "
+        "(2 q[k-1] - q[k-2]) follows the robot (the previous pose makes it turn back); the "
+        "aspect test cannot tell apart two modes of one aspect; "
+        + (
+            ""
+            if actuation == "revolute"
+            else "the sampling misses a root pair that round-off keeps from touching zero and "
+            "three roots in one cell; "
+        )
+        + "the fallback costs several Newton solves. No allocation, no state."
     )
 
 
@@ -492,6 +500,11 @@ def forward_kinematics(actuation: str) -> FunctionSpec:
        line ``u . w = rho`` of the longer ``w`` and the circle ``|u| = L_A`` (none if both
        ``w`` vanish); each candidate polished by the same Newton (20 steps), dropped when it
        does not converge. No mode at all: ``RPR3_NO_MODE``, the output untouched.
+
+    Limits (``docs/control-model.md``, "Known limitations"): through a parallel singularity only
+    a predicted reference follows the robot; ``sign det J`` cannot tell apart two modes of one
+    aspect; the sampling misses a root pair that round-off keeps from touching zero, and three
+    roots in one cell; the fallback costs 5 to 20 Newton solves.
 
     Fixed-size arrays, fixed loop bounds, no allocation or state. The numbers are
     :data:`FK_TUNING`; ``trace=True`` (test builds only) makes the body call
