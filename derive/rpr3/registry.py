@@ -435,14 +435,101 @@ def pose_from_angle(actuation: str) -> FunctionSpec | None:
     )
 
 
+#: The tracked forward kinematics' numbers, for its C body (``c_context``), as in
+#: ``tests/fk_reference.py`` (``tracked_forward_kinematics``), whose prototype it ports.
+FK_TUNING: tuple[tuple[str, object], ...] = (
+    ("max_iter", 8),  # Newton steps from q_near before the fallback
+    ("polish_iter", 20),  # Newton steps polishing a mode of the sextic (prismatic)
+    ("max_halvings", 12),  # of the step, in the line search
+    ("tol", "1e-12"),  # converged: the largest residual |qa(q) - qa| (rad or m)
+    ("det_tol", "1e-14"),  # singular J: |det J| under this times the product of its row norms
+    ("samples", 256),  # cells of t in [-1, 1], and as many of u = 1/t in [-1, 1] (prismatic)
+    ("bisections", 60),  # per root, or per extremum of a cell without a sign change
+    ("touch_tol", "1e-9"),  # an extremum within this of the sextic's scale of zero is a root
+    ("merge_tol", "1e-9"),  # roots (rad) closer than this are one
+    ("parallel_tol", "1e-6"),  # back substitution: |D| <= this |w_B| |w_C| is parallel
+    ("max_roots", 16),  # sampled roots kept (a real sextic has 6; t = +-1 is sampled twice)
+)
+
+
+def _forward_kinematics_doc(actuation: str) -> str:
+    """The header's comment of ``rpr3_forward_kinematics``, with the numbers of FK_TUNING."""
+    n = dict(FK_TUNING)
+    if actuation == "revolute":
+        modes = "both closed-form modes of assembly_modes (where their margins are >= 0)"
+    else:
+        modes = (
+            "the real roots of the sextic of assembly_modes, without a polynomial solver: "
+            f"sampled at {n['samples']} cells of t = tan(phi/2) in [-1, 1] and as many of "
+            "1/t in [-1, 1], each sign change bisected, a cell with an extremum split there "
+            "(close pairs, double roots); back substituted by pose_from_angle (or, where its "
+            "two equations are parallel, by a line and a circle) and polished by the same "
+            f"Newton ({n['polish_iter']} steps); none when a leg length l0 + l2 + qa_i is not "
+            "positive"
+        )
+    return (
+        "Tracked forward kinematics: the assembly mode of the actuator coordinates qa nearest "
+        "the reference pose q_near (distance in (x, y, rho phi), rho the platform's RMS joint "
+        "radius), phi unwrapped next to q_near's. (1) Damped Newton from q_near with the "
+        "generated Jacobian: J dq = -r (r = qa(q) - qa, angles wrapped), the step limited to "
+        f"rho in that metric and halved (at most {n['max_halvings']} times) until the largest "
+        f"residual drops by 1 - t/2; converged when it is <= {n['tol']} (rad or m), at most "
+        f"{n['max_iter']} steps. (2) Its pose is returned when it converged, every leg has a "
+        "positive length and det J has the sign it has at q_near (same aspect). (3) Otherwise "
+        "(no convergence, a singular J, a failed line search, another aspect) the fallback: "
+        f"every mode, {modes}; the nearest wins. RPR3_NO_MODE, q untouched, when there is no "
+        "mode. Limits: through a parallel singularity only a predicted reference "
+        "(2 q[k-1] - q[k-2]) follows the robot (the previous pose makes it turn back); the "
+        "aspect test cannot tell apart two modes of one aspect; "
+        + (
+            ""
+            if actuation == "revolute"
+            else "the sampling misses a root pair that round-off keeps from touching zero and "
+            "three roots in one cell; "
+        )
+        + "the fallback costs several Newton solves. No allocation, no state."
+    )
+
+
 def forward_kinematics(actuation: str) -> FunctionSpec:
     """``rpr3_forward_kinematics``: the assembly mode of ``qa`` nearest a reference pose.
 
-    Damped Newton on ``qa(q) = qa`` from ``q_near`` with the generated Jacobian; when it does not
-    converge, leaves the reference's aspect or gives a leg of no length, every mode (closed form,
-    or the sextic's roots found by sampling and bisection) and the nearest in ``(x, y, rho phi)``.
-    C only (``templates/forward_kinematics.c.jinja``); Python composes the same from
-    ``assembly_modes`` and ``pose_from_angle``.
+    C only: a hand-written body (``templates/forward_kinematics.c.jinja``) that calls the
+    generated kernels of ``actuator_coordinates``, ``actuator_jacobian``, ``assembly_modes`` and
+    ``pose_from_angle``; it ports ``tests/fk_reference.py`` (``tracked_forward_kinematics``).
+
+    1. Damped Newton on ``qa(q) = qa`` from ``q_near`` (residual of angles wrapped): ``J dq =
+       -r`` by cofactors, the step limited to ``rho`` in the metric ``(x, y, rho phi)``, halved
+       (at most 12 times) until the largest residual drops by ``1 - t/2``; converged when the
+       largest residual is ``<= 1e-12`` (rad or m), at most 8 steps. It fails on a singular J
+       (``|det J| <= 1e-14`` times the product of its row norms), a failed line search or the
+       step limit.
+    2. Its pose is accepted when it converged, every leg has a positive length (revolute:
+       ``(A3 - A1) . e_i`` along the measured leg axis; prismatic: ``|A1A3|``; above
+       ``LENGTH_TOL rho``) and ``det J`` has the sign it has at ``q_near`` (no crossing of a
+       parallel singularity into the other aspect).
+    3. Else the fallback: every assembly mode, each with ``phi`` wrapped, then unwrapped next to
+       ``q_near[2]``, and the nearest in ``(x, y, rho phi)``. Revolute: both closed-form modes
+       of ``assembly_modes`` where their margins are ``>= 0``. Prismatic: no mode when a leg
+       length ``l0 + l2 + qa_i <= LENGTH_TOL rho`` or the sextic vanishes; its real roots by
+       sampling ``p(t)`` at 257 points of ``t`` in ``[-1, 1]`` and ``u^6 p(1/u)`` at 257 points
+       of ``u = 1/t`` in ``[-1, 1]``, 60 bisections per sign change, a cell without one but
+       with a sign change of ``p'`` split at the extremum (two close roots, or a double root if
+       ``p`` touches zero there to ``1e-9`` of its scale); roots merged within 1e-9 rad, at most
+       6; back substitution by ``pose_from_angle``, or where ``|D| <= 1e-6 |w_B| |w_C|`` by the
+       line ``u . w = rho`` of the longer ``w`` and the circle ``|u| = L_A`` (none if both
+       ``w`` vanish); each candidate polished by the same Newton (20 steps), dropped when it
+       does not converge. No mode at all: ``RPR3_NO_MODE``, the output untouched.
+
+    Limits (``docs/control-model.md``, "Known limitations"): through a parallel singularity only
+    a predicted reference follows the robot; ``sign det J`` cannot tell apart two modes of one
+    aspect; the sampling misses a root pair that round-off keeps from touching zero, and three
+    roots in one cell; the fallback costs 5 to 20 Newton solves.
+
+    Fixed-size arrays, fixed loop bounds, no allocation or state. The numbers are
+    :data:`FK_TUNING`; ``trace=True`` (test builds only) makes the body call
+    ``rpr3_fk_trace(steps, how)`` (``how``: 0 Newton, 1 fallback, 2 none), which the test's
+    harness defines.
     """
     qa = actuator_argument(actuation)
     near = Argument(
@@ -453,10 +540,7 @@ def forward_kinematics(actuation: str) -> FunctionSpec:
     )
     return FunctionSpec(
         name="forward_kinematics",
-        doc="Tracked forward kinematics: the assembly mode of the actuator coordinates qa "
-        "nearest the reference pose q_near (distance in (x, y, rho phi), rho the platform's "
-        "RMS joint radius), phi unwrapped next to q_near's. Damped Newton with the generated "
-        "Jacobian; when it fails, every mode and the nearest. RPR3_NO_MODE when there is none.",
+        doc=_forward_kinematics_doc(actuation),
         inputs=(qa, near),
         outputs=(
             Output(
@@ -473,6 +557,9 @@ def forward_kinematics(actuation: str) -> FunctionSpec:
             ("actuation", actuation),
             ("max_modes", control.MAX_MODES[actuation]),
             ("length_tol", repr(control.LENGTH_TOL)),
+            ("param_names", PARAM_NAMES),
+            *FK_TUNING,
+            ("trace", False),
         ),
     )
 
