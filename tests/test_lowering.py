@@ -78,3 +78,25 @@ def test_buffers_are_reused_and_aliases_and_constants_are_written() -> None:
     rows = {name: f"out[{i}]" for i, (name, _) in enumerate(code.outputs)}
     lowered = lower_numpy(code, {a: "a", b: "b"}, {k, m}, rows)
     assert lowered.buffers <= 3  # three live values at most, never one buffer per operation
+
+
+def test_a_value_read_only_by_an_output_keeps_its_buffer() -> None:
+    # t1 is last read by a statement (t2), then by an output expression; the buffers freed after
+    # t2 are reused by t3, which must not overwrite t1 (the bug the derivation notebook found in
+    # the generated Jacobian: outputs were not counted as uses).
+    rng = np.random.default_rng(3)
+    n = 16
+    values = {a: rng.uniform(1, 2, n), b: rng.uniform(1, 2, n), k: 2.0, m: 3.0}
+    t4 = sp.Symbol("t4", real=True)
+    code = StraightLine(
+        assignments=((t1, a * b), (t2, t1 + a), (t3, a - 2 * b), (t4, b * b * a)),
+        outputs=(("t1 twice", 2 * t1), ("t2", t2 * k), ("t3", t3), ("t4 over t1", t4 / t1)),
+        ops_before=0,
+        ops_after=0,
+    )
+    out = _run(code, values, n)
+    x1 = values[a] * values[b]
+    np.testing.assert_allclose(out[0], 2 * x1, rtol=1e-15)
+    np.testing.assert_allclose(out[1], (x1 + values[a]) * 2.0, rtol=1e-15)
+    np.testing.assert_allclose(out[2], values[a] - 2 * values[b], rtol=1e-15)
+    np.testing.assert_allclose(out[3], values[b] ** 2 * values[a] / x1, rtol=1e-14)

@@ -235,10 +235,13 @@ def lower_numpy(
     for name, expr in code.outputs:
         if expr.is_Symbol and expr not in alias and expr not in inputs:
             alias[expr] = output_rows[name]
-    uses: dict[sp.Symbol, int] = {}
+    uses: dict[sp.Symbol, int] = {}  # index of each symbol's last use
     for index, (_, rhs) in enumerate(statements):
         for sym in rhs.free_symbols:
             uses[sym] = index
+    for _, expr in code.outputs:  # read by an output: alive to the end
+        for sym in expr.free_symbols:
+            uses[sym] = len(statements)
     state = _Lowering(scalars=set(params))
     state.location.update(inputs)
     scalar_lines: list[str] = []
