@@ -27,10 +27,8 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike
 
-from rpr3gen import manifest
 from rpr3gen.backends import evaluate, samples
 from rpr3gen.model import LEGS, Model
-from rpr3gen.policy import leg_extensions
 
 __all__ = [
     "actuator_coordinates",
@@ -171,8 +169,10 @@ def assembly_modes(model: Model, qa: ArrayLike, backend: str = "numpy") -> np.nd
 
     ``k <= 2`` with revolute actuation (closed form), ``k <= 6`` with prismatic (the sextic).
     A mode has every leg of positive length along its axis (docs/interfaces.md) and, as
-    everywhere in rpr3gen, every piston joint in front of its base pivot (``reach`` above the
-    generated ``MIN_REACH``); stroke limits are not applied.
+    everywhere in rpr3gen, is a pose the generated code evaluates: every piston joint in front of
+    its base pivot (``reach`` above the generated ``MIN_REACH``) and ``conditioning`` above
+    ``MIN_CONDITIONING`` (a mode at a parallel singularity, a double one, is refused as
+    :func:`rpr3gen.inverse_dynamics` refuses it); stroke limits are not applied.
     """
     row = samples("qa", qa, 3)[0]
     if model.actuation == "revolute":
@@ -191,9 +191,10 @@ def assembly_modes(model: Model, qa: ArrayLike, backend: str = "numpy") -> np.nd
         candidates = np.column_stack([xy, phi])
         found = _polish(model, candidates, row, backend)
     modes = _distinct(model, found)
-    floor = manifest.load(model.actuation, model.generated).thresholds["MIN_REACH"]
-    reach = leg_extensions(model, modes).min(axis=1) / model.params["l0"] if len(modes) else []
-    return modes[np.asarray(reach) >= floor] if len(modes) else modes
+    if not len(modes):
+        return modes
+    # Only poses the generated code evaluates: reach and conditioning above their floors.
+    return modes[np.isfinite(actuator_coordinates(model, modes, backend)).all(axis=1)]
 
 
 def forward_kinematics(
