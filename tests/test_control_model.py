@@ -42,26 +42,14 @@ MAX_MODES = {"revolute": 2, "prismatic": 6}
 #: The paper's robot and three random ones (seeds of ``newton_euler.random_robot``).
 ROBOTS: tuple[str | int, ...] = ("paper", 1, 2, 3)
 
-# The generated NumPy ``rpr3_actuator_jacobian`` of revolute actuation returns a wrong J (the C is
-# right): derive/codegen/backends/python/lowering.py computes liveness over the assignments only,
-# not over the output expressions, so work rows still needed by ``J[k] = a * b`` are reused first.
-# Strict: once the generated code is fixed, these cases pass and the mark must go.
-NUMPY_REVOLUTE_JACOBIAN_BUG = pytest.mark.xfail(
-    reason="derive/ NumPy lowering reuses live work rows: revolute actuator_jacobian is wrong",
-    strict=True,
-)
 
-
-def _cases(uses_jacobian: bool = True) -> list[object]:
-    """(actuation, backend) parameters; with ``uses_jacobian`` (the test evaluates J) the NumPy
-    revolute one is marked for the Jacobian bug."""
-    out: list[object] = []
-    for actuation in ACTUATIONS:
-        for backend in BACKENDS:
-            wrong = uses_jacobian and (actuation, backend) == ("revolute", "numpy")
-            marks = [NUMPY_REVOLUTE_JACOBIAN_BUG] if wrong else []
-            out.append(pytest.param(actuation, backend, marks=marks, id=f"{actuation}-{backend}"))
-    return out
+def _cases() -> list[object]:
+    """Every (actuation, backend) pair."""
+    return [
+        pytest.param(actuation, backend, id=f"{actuation}-{backend}")
+        for actuation in ACTUATIONS
+        for backend in BACKENDS
+    ]
 
 
 def _model(actuation: str, robot: str | int, payload: bool = True) -> Model:
@@ -439,7 +427,7 @@ def test_jacobian_rate_is_the_derivative_of_the_jacobian_along_the_motion(
 
 
 @pytest.mark.parametrize("robot", ROBOTS)
-@pytest.mark.parametrize(("actuation", "backend"), _cases(uses_jacobian=False))
+@pytest.mark.parametrize(("actuation", "backend"), _cases())
 def test_jacobian_rate_is_the_leg_acceleration_at_rest_platform_acceleration(
     actuation: str, backend: str, robot: str | int
 ) -> None:
@@ -552,7 +540,7 @@ def _acceleration_error(found: np.ndarray, expected: np.ndarray) -> float:
 
 
 @pytest.mark.parametrize("motion", NE_MOTIONS)
-@pytest.mark.parametrize(("actuation", "backend"), _cases(uses_jacobian=False))
+@pytest.mark.parametrize(("actuation", "backend"), _cases())
 def test_forward_dynamics_of_newton_euler_efforts(
     actuation: str, backend: str, motion: str | int
 ) -> None:
@@ -563,7 +551,7 @@ def test_forward_dynamics_of_newton_euler_efforts(
 
 
 @pytest.mark.parametrize("robot", ROBOTS)
-@pytest.mark.parametrize(("actuation", "backend"), _cases(uses_jacobian=False))
+@pytest.mark.parametrize(("actuation", "backend"), _cases())
 def test_forward_dynamics_inverts_inverse_dynamics(
     actuation: str, backend: str, robot: str | int
 ) -> None:
@@ -605,7 +593,7 @@ ENERGY_RUNS = [
 
 
 @pytest.mark.parametrize(("robot", "starts", "duration"), ENERGY_RUNS)
-@pytest.mark.parametrize(("actuation", "backend"), _cases(uses_jacobian=False))
+@pytest.mark.parametrize(("actuation", "backend"), _cases())
 def test_gravity_alone_conserves_energy(
     actuation: str,
     backend: str,
@@ -672,14 +660,11 @@ FUNCTIONS = (
 
 
 def _functions() -> list[object]:
-    out: list[object] = []
-    for actuation in ACTUATIONS:
-        for function in FUNCTIONS:
-            uses_j = function in ("actuator_jacobian", "platform_velocity")
-            wrong = actuation == "revolute" and uses_j
-            marks = [NUMPY_REVOLUTE_JACOBIAN_BUG] if wrong else []
-            out.append(pytest.param(actuation, function, marks=marks, id=f"{actuation}-{function}"))
-    return out
+    return [
+        pytest.param(actuation, function, id=f"{actuation}-{function}")
+        for actuation in ACTUATIONS
+        for function in FUNCTIONS
+    ]
 
 
 @pytest.mark.parametrize("robot", ROBOTS)
