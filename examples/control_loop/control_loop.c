@@ -1,12 +1,20 @@
-/* 1 kHz computed-torque tracking of the paper's trajectory with the generated inverse dynamics.
+/* 1 kHz task-space computed-torque tracking of the paper's trajectories, closed on encoders.
  *
- * The controller feeds the desired acceleration plus a PD correction to rpr3_inverse_dynamics
- * with the nominal model; the plant is the same robot with true masses and inertias a few
- * percent off, integrated forward from the motor torques (its dynamics are affine in the
- * acceleration, so four inverse-dynamics calls give the mass matrix and the bias). Prints the
- * tracking error and the latency distribution of the controller's call.
+ * Plant: the robot with masses and inertias a few percent off the model, its platform state
+ * (q, qd) integrated by RK4 of the generated rpr3_forward_dynamics, four substeps per tick,
+ * under the efforts held over the tick. Sensors: the actuator coordinates of the plant
+ * (rpr3_actuator_coordinates) rounded to whole encoder counts: 2^17 counts per revolution
+ * (revolute actuation) or 1 um per count (prismatic). Controller, nominal model, every tick:
+ *   qa    = counts * resolution;  qa' = (counts - previous counts) * resolution / dt, low-pass
+ *   q     = rpr3_forward_kinematics(qa, q_near = 2 q[k-1] - q[k-2])   (tracked)
+ *   q'    : J(q) q' = qa'                                              (rpr3_actuator_jacobian)
+ *   M, c  = rpr3_task_space_dynamics(q, q')
+ *   tau   : J^T tau = M (qdd_d + Kd (qd_d - q') + Kp (q_d - q)) + c
+ * Prints the tracking error, the pose and velocity estimates' errors, the failed calls and the
+ * latency (p50, p99, max) of the forward kinematics, of the dynamics (M, c and the solve) and of
+ * the whole tick. The variant (actuation) is the generated folder the program is built with.
  *
- *   make && ./control_loop paper.params [rectilinear|rotation] [seconds]
+ *   make && ./control_loop_revolute paper.params [rectilinear|rotation] [SECONDS] [OFFSET_MM]
  *
  * paper.params: "name value" lines, e.g. from `rpr3gen params > paper.params`.
  */
@@ -21,8 +29,15 @@
 #include "rpr3.h"
 
 #define PI 3.14159265358979323846
-#define RATE_HZ 1000
-#define SUBSTEPS 4
+#define RATE_HZ 1000          /* controller ticks per second */
+#define SUBSTEPS 4            /* RK4 steps of the plant per tick (4 kHz) */
+#define KP 900.0              /* s^-2 */
+#define KD 60.0               /* s^-1: critically damped at 30 rad/s */
+#define RATE_CUTOFF_HZ 100.0  /* first-order low-pass on the differenced counts */
+#define TRANSIENT 0.05        /* s, left out of the "after" tracking error */
+#define COUNTS_PER_REV 131072 /* 2^17, revolute actuation */
+#define METRES_PER_COUNT 1e-6 /* prismatic actuation */
+#define DURATION 3.0          /* s, the paper's motions (eq. 3) */
 
 static int index_of(const char *const *names, int count, const char *name)
 {
@@ -69,60 +84,178 @@ static int read_params(const char *path, double *params)
     return seen;
 }
 
-/* Paper eq. (3): q/q* = 1 - cos(pi t / T), and its derivatives. */
-static void reference(const double *amplitude, double t, double duration, double *q, double *qd,
-                      double *qdd)
+static double now_ns(void)
 {
-    const double w = PI / duration;
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec * 1e9 + ts.tv_nsec;
+}
+
+/* Paper eq. (3), q = q* (1 - cos(pi t / T)), and its first two derivatives. */
+static void reference(const double *amplitude, double t, double *q, double *qd, double *qdd)
+{
+    const double w = PI / DURATION;
     int k;
     for (k = 0; k < 3; ++k) {
         q[k] = amplitude[k] * (1.0 - cos(w * t));
-        qd[k] = amplitude[k] * w * sin(w * t);
-        qdd[k] = amplitude[k] * w * w * cos(w * t);
+        qd[k] = amplitude[k] * (w * sin(w * t));
+        qdd[k] = amplitude[k] * (w * w * cos(w * t));
     }
 }
 
-/* Plant: the platform acceleration produced by the motor torques tau, from the true model. */
-static int forward_dynamics(const double *params, const int *actuator, const double *q,
-                            const double *qd, const double *tau, double *qdd)
+/* Solves A x = b (transpose = 0) or A^T x = b (transpose = 1), A 3x3 row-major, by the
+ * cofactors: A^-1 = C^T / det A. Returns -1, x untouched, when A is singular to round-off. */
+static int solve3(const double *a, const double *b, int transpose, double *x)
 {
-    double out[RPR3_NUM_OUTPUTS];
-    double bias[3], a[3][3], rhs[3], det;
-    double unit[3] = {0.0, 0.0, 0.0};
+    double cof[9], det, scale = 1.0, y[3];
     int i, j;
-    if (rpr3_inverse_dynamics(params, q, qd, unit, out) != RPR3_OK) {
+    for (i = 0; i < 3; ++i) {
+        const double *r1 = a + 3 * ((i + 1) % 3), *r2 = a + 3 * ((i + 2) % 3);
+        for (j = 0; j < 3; ++j) {
+            const int j1 = (j + 1) % 3, j2 = (j + 2) % 3;
+            cof[3 * i + j] = r1[j1] * r2[j2] - r1[j2] * r2[j1];
+        }
+        scale *= sqrt(a[3 * i] * a[3 * i] + a[3 * i + 1] * a[3 * i + 1] + a[3 * i + 2] * a[3 * i + 2]);
+    }
+    det = a[0] * cof[0] + a[1] * cof[1] + a[2] * cof[2];
+    if (!(fabs(det) > 1e-12 * scale)) {
         return -1;
     }
     for (i = 0; i < 3; ++i) {
-        bias[i] = out[actuator[i]];
-    }
-    for (j = 0; j < 3; ++j) {
-        unit[j] = 1.0;
-        if (rpr3_inverse_dynamics(params, q, qd, unit, out) != RPR3_OK) {
-            return -1;
-        }
-        unit[j] = 0.0;
-        for (i = 0; i < 3; ++i) {
-            a[i][j] = out[actuator[i]] - bias[i];
+        y[i] = 0.0;
+        for (j = 0; j < 3; ++j) {
+            y[i] += (transpose ? cof[3 * i + j] : cof[3 * j + i]) * b[j];
         }
     }
     for (i = 0; i < 3; ++i) {
-        rhs[i] = tau[i] - bias[i];
-    }
-    det = a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1])
-        - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0])
-        + a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);
-    for (j = 0; j < 3; ++j) { /* Cramer's rule */
-        double m[3][3];
-        memcpy(m, a, sizeof m);
-        for (i = 0; i < 3; ++i) {
-            m[i][j] = rhs[i];
-        }
-        qdd[j] = (m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
-                  - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
-                  + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])) / det;
+        x[i] = y[i] / det;
     }
     return 0;
+}
+
+/* Plant: one tick of RK4 of the true forward dynamics under the efforts tau, in substeps. */
+static int plant_step(const double *truth, double *q, double *qd, const double *tau, double dt)
+{
+    const double h = dt / SUBSTEPS;
+    int s, k;
+    for (s = 0; s < SUBSTEPS; ++s) {
+        double a1[3], a2[3], a3[3], a4[3], q2[3], v2[3], q3[3], v3[3], q4[3], v4[3];
+        if (rpr3_forward_dynamics(truth, q, qd, tau, a1) != RPR3_OK) {
+            return -1;
+        }
+        for (k = 0; k < 3; ++k) {
+            q2[k] = q[k] + 0.5 * h * qd[k];
+            v2[k] = qd[k] + 0.5 * h * a1[k];
+        }
+        if (rpr3_forward_dynamics(truth, q2, v2, tau, a2) != RPR3_OK) {
+            return -1;
+        }
+        for (k = 0; k < 3; ++k) {
+            q3[k] = q[k] + 0.5 * h * v2[k];
+            v3[k] = qd[k] + 0.5 * h * a2[k];
+        }
+        if (rpr3_forward_dynamics(truth, q3, v3, tau, a3) != RPR3_OK) {
+            return -1;
+        }
+        for (k = 0; k < 3; ++k) {
+            q4[k] = q[k] + h * v3[k];
+            v4[k] = qd[k] + h * a3[k];
+        }
+        if (rpr3_forward_dynamics(truth, q4, v4, tau, a4) != RPR3_OK) {
+            return -1;
+        }
+        for (k = 0; k < 3; ++k) {
+            q[k] += h / 6.0 * (qd[k] + 2.0 * v2[k] + 2.0 * v3[k] + v4[k]);
+            qd[k] += h / 6.0 * (a1[k] + 2.0 * a2[k] + 2.0 * a3[k] + a4[k]);
+        }
+    }
+    return 0;
+}
+
+/* Sensors: the plant's actuator coordinates rounded to whole counts. */
+static int encoders(const double *truth, const double *q, double resolution, long *counts)
+{
+    double qa[3];
+    int k;
+    if (rpr3_actuator_coordinates(truth, q, qa) != RPR3_OK) {
+        return -1;
+    }
+    for (k = 0; k < 3; ++k) {
+        counts[k] = lround(qa[k] / resolution);
+    }
+    return 0;
+}
+
+struct controller {
+    const double *params; /* the nominal model */
+    double amplitude[3];  /* of the trajectory, eq. (3) */
+    double resolution;    /* rad or m per count */
+    double alpha;         /* of the rate filter */
+    double q1[3], q2[3];  /* the last two pose estimates */
+    long counts[3];       /* the previous reading */
+    int started;
+    double rate[3];       /* filtered actuator rates */
+    double qd[3];         /* velocity estimate */
+    double tau[3];        /* the efforts commanded */
+    long failed_fk, failed_jacobian, failed_dynamics;
+    double fk_ns, dynamics_ns; /* latencies of this tick's calls */
+};
+
+/* One tick: encoder counts at time t in, ctl->tau out. */
+static void controller_tick(struct controller *ctl, const long *counts, double t)
+{
+    const double dt = 1.0 / RATE_HZ;
+    double qa[3], near[3], q[3], J[9], M[9], c[3], f[3], q_d[3], qd_d[3], qdd_d[3], acc[3];
+    double start;
+    int status, i, k;
+
+    for (k = 0; k < 3; ++k) { /* actuator positions and rates from the counts */
+        qa[k] = counts[k] * ctl->resolution;
+        if (ctl->started) {
+            const double raw = (counts[k] - ctl->counts[k]) * (ctl->resolution / dt);
+            ctl->rate[k] += ctl->alpha * (raw - ctl->rate[k]);
+        }
+        ctl->counts[k] = counts[k];
+        near[k] = 2.0 * ctl->q1[k] - ctl->q2[k];
+    }
+    ctl->started = 1;
+
+    start = now_ns(); /* the pose: tracked forward kinematics from the prediction */
+    status = rpr3_forward_kinematics(ctl->params, qa, near, q);
+    ctl->fk_ns = now_ns() - start;
+    if (status != RPR3_OK) {
+        ++ctl->failed_fk;
+        memcpy(q, near, sizeof q); /* coast on the prediction */
+    }
+    memcpy(ctl->q2, ctl->q1, sizeof q);
+    memcpy(ctl->q1, q, sizeof q);
+
+    if (rpr3_actuator_jacobian(ctl->params, q, J) != RPR3_OK
+        || solve3(J, ctl->rate, 0, ctl->qd) != 0) { /* the velocity: J q' = qa' */
+        ++ctl->failed_jacobian;
+        ctl->dynamics_ns = 0.0;
+        return; /* hold the last efforts */
+    }
+
+    reference(ctl->amplitude, t, q_d, qd_d, qdd_d);
+    for (k = 0; k < 3; ++k) {
+        acc[k] = qdd_d[k] + KD * (qd_d[k] - ctl->qd[k]) + KP * (q_d[k] - q[k]);
+    }
+    start = now_ns(); /* computed torque in task space: J^T tau = M acc + c */
+    status = rpr3_task_space_dynamics(ctl->params, q, ctl->qd, M, c);
+    if (status == RPR3_OK) {
+        for (i = 0; i < 3; ++i) {
+            f[i] = c[i];
+            for (k = 0; k < 3; ++k) {
+                f[i] += M[3 * i + k] * acc[k];
+            }
+        }
+        status = solve3(J, f, 1, ctl->tau);
+    }
+    ctl->dynamics_ns = now_ns() - start;
+    if (status != RPR3_OK) {
+        ++ctl->failed_dynamics;
+    }
 }
 
 static int compare(const void *a, const void *b)
@@ -131,100 +264,151 @@ static int compare(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
+static void print_latency(const char *label, double *ns, long n)
+{
+    qsort(ns, (size_t)n, sizeof *ns, compare);
+    printf("latency %s: p50 %.0f ns, p99 %.0f ns, max %.0f ns\n", label, ns[n / 2],
+           ns[(long)(0.99 * (n - 1))], ns[n - 1]);
+}
+
+struct stats {
+    double sum[2], max[2]; /* position (m), angle (rad) */
+    long n;
+};
+
+static void add(struct stats *s, double position, double angle)
+{
+    s->sum[0] += position * position;
+    s->sum[1] += angle * angle;
+    s->max[0] = position > s->max[0] ? position : s->max[0];
+    s->max[1] = angle > s->max[1] ? angle : s->max[1];
+    ++s->n;
+}
+
 int main(int argc, char **argv)
 {
     double nominal[RPR3_NUM_PARAMS], truth[RPR3_NUM_PARAMS];
     const char *perturbed[] = {"m1", "m2", "m3", "J1", "J2", "J3"};
     const double factor[] = {1.03, 0.96, 1.05, 1.04, 0.97, 1.05};
-    double amplitude[3];
     const char *name = argc > 2 ? argv[2] : "rectilinear";
-    const double duration = 3.0;
-    const double seconds = argc > 3 ? atof(argv[3]) : duration;
-    const double dt = 1.0 / RATE_HZ, kp = 900.0, kd = 60.0;
-    const long steps = (long)(seconds * RATE_HZ + 0.5);
-    int actuator[3];
-    double q[3] = {0.001, -0.001, 0.0}, qd[3] = {0.0, 0.0, 0.0};
+    const double seconds = argc > 3 ? atof(argv[3]) : DURATION;
+    const double offset = argc > 4 ? atof(argv[4]) : 0.0; /* mm */
+    const int revolute = strcmp(RPR3_ACTUATION, "revolute") == 0;
+    const double dt = 1.0 / RATE_HZ;
+    const long steps = (long)(seconds * RATE_HZ + 0.5), transient = (long)(TRANSIENT * RATE_HZ + 0.5);
+    const char *unit = revolute ? "N m" : "N";
+    struct controller ctl;
+    struct stats after = {{0.0, 0.0}, {0.0, 0.0}, 0}, overall = after, estimate = after;
+    double q[3], qd[3] = {0.0, 0.0, 0.0}, velocity_sq[2] = {0.0, 0.0};
+    double tau_sq = 0.0, dtau_sq = 0.0, dtau_max = 0.0, previous_tau[3] = {0.0, 0.0, 0.0};
     double *latency;
-    double max_pos = 0.0, max_ang = 0.0, sum_pos = 0.0, final_pos = 0.0;
-    long step, failed = 0;
-    int i, k;
+    long step, counts[3];
+    int k;
 
-    if (argc < 2 || read_params(argv[1], nominal) < 0) {
-        fprintf(stderr, "usage: control_loop PARAMS_FILE [rectilinear|rotation] [seconds]\n");
+    if (argc < 2 || argc > 5 || read_params(argv[1], nominal) < 0) {
+        fprintf(stderr, "usage: control_loop PARAMS_FILE [rectilinear|rotation] [SECONDS] "
+                        "[OFFSET_MM]\n");
         return 2;
     }
+    memset(&ctl, 0, sizeof ctl);
     if (strcmp(name, "rectilinear") == 0) {
-        amplitude[0] = 0.05, amplitude[1] = -0.05, amplitude[2] = 0.0;
+        ctl.amplitude[0] = 0.05, ctl.amplitude[1] = -0.05, ctl.amplitude[2] = 0.0;
     } else if (strcmp(name, "rotation") == 0) {
-        amplitude[0] = 0.0, amplitude[1] = 0.0, amplitude[2] = PI / 6.0;
+        ctl.amplitude[0] = 0.0, ctl.amplitude[1] = 0.0, ctl.amplitude[2] = PI / 6.0;
     } else {
         fprintf(stderr, "control_loop: unknown trajectory %s\n", name);
         return 2;
     }
-    if (steps <= 0) {
-        fprintf(stderr, "control_loop: the duration must be positive\n");
+    if (steps <= 0 || !isfinite(offset)) {
+        fprintf(stderr, "control_loop: the duration must be positive, the offset finite\n");
         return 2;
     }
     memcpy(truth, nominal, sizeof truth);
     for (k = 0; k < 6; ++k) {
         truth[index_of(rpr3_param_names, RPR3_NUM_PARAMS, perturbed[k])] *= factor[k];
     }
-    for (i = 0; i < 3; ++i) { /* the actuated joint's load of each leg */
-        char column[16];
-        sprintf(column, "%s_%c", strcmp(RPR3_ACTUATION, "revolute") == 0 ? "m10" : "f21z",
-                "ABC"[i]);
-        actuator[i] = index_of(rpr3_output_names, RPR3_NUM_OUTPUTS, column);
-    }
-    latency = malloc((size_t)steps * sizeof *latency);
+    ctl.params = nominal;
+    ctl.resolution = revolute ? 2.0 * PI / COUNTS_PER_REV : METRES_PER_COUNT;
+    ctl.alpha = 1.0 - exp(-2.0 * PI * RATE_CUTOFF_HZ / RATE_HZ);
+    q[0] = 1e-3 * offset, q[1] = 0.0 - 1e-3 * offset, q[2] = 0.0; /* the controller assumes home */
+    latency = malloc(3 * (size_t)steps * sizeof *latency); /* fk, dynamics, tick */
     if (latency == NULL) {
+        fprintf(stderr, "control_loop: out of memory\n");
         return 1;
     }
 
     for (step = 0; step < steps; ++step) {
         const double t = step * dt;
-        double q_des[3], qd_des[3], qdd_des[3], qdd_cmd[3], out[RPR3_NUM_OUTPUTS], tau[3];
-        double pos;
-        struct timespec start, stop;
-        reference(amplitude, t, duration, q_des, qd_des, qdd_des);
+        double start, q_d[3], qd_d[3], qdd_d[3], dq[3];
+        if (encoders(truth, q, ctl.resolution, counts) != 0) {
+            fprintf(stderr, "control_loop: the plant reached a singular pose at t = %g s\n", t);
+            free(latency);
+            return 1;
+        }
+        start = now_ns();
+        controller_tick(&ctl, counts, t);
+        latency[2 * steps + step] = now_ns() - start;
+        latency[step] = ctl.fk_ns;
+        latency[steps + step] = ctl.dynamics_ns;
+
         for (k = 0; k < 3; ++k) {
-            qdd_cmd[k] = qdd_des[k] + kd * (qd_des[k] - qd[k]) + kp * (q_des[k] - q[k]);
-        }
-        clock_gettime(CLOCK_MONOTONIC, &start);
-        if (rpr3_inverse_dynamics(nominal, q, qd, qdd_cmd, out) != RPR3_OK) {
-            ++failed;
-            continue;
-        }
-        clock_gettime(CLOCK_MONOTONIC, &stop);
-        latency[step] = (stop.tv_sec - start.tv_sec) * 1e9 + (stop.tv_nsec - start.tv_nsec);
-        for (i = 0; i < 3; ++i) {
-            tau[i] = out[actuator[i]];
-        }
-        for (k = 0; k < SUBSTEPS; ++k) { /* semi-implicit Euler */
-            double acc[3];
-            if (forward_dynamics(truth, actuator, q, qd, tau, acc) != 0) {
-                fprintf(stderr, "control_loop: the plant reached a singular pose at t = %g s\n", t);
-                free(latency);
-                return 1;
+            dq[k] = ctl.qd[k] - qd[k];
+            tau_sq += ctl.tau[k] * ctl.tau[k];
+            if (step > 0) {
+                const double d = fabs(ctl.tau[k] - previous_tau[k]);
+                dtau_sq += d * d;
+                dtau_max = d > dtau_max ? d : dtau_max;
             }
-            for (i = 0; i < 3; ++i) {
-                qd[i] += acc[i] * dt / SUBSTEPS;
-                q[i] += qd[i] * dt / SUBSTEPS;
-            }
+            previous_tau[k] = ctl.tau[k];
         }
-        reference(amplitude, t + dt, duration, q_des, qd_des, qdd_des);
-        pos = hypot(q[0] - q_des[0], q[1] - q_des[1]);
-        max_pos = pos > max_pos ? pos : max_pos;
-        max_ang = fabs(q[2] - q_des[2]) > max_ang ? fabs(q[2] - q_des[2]) : max_ang;
-        sum_pos += pos * pos;
-        final_pos = pos;
+        add(&estimate, hypot(ctl.q1[0] - q[0], ctl.q1[1] - q[1]), fabs(ctl.q1[2] - q[2]));
+        velocity_sq[0] += dq[0] * dq[0] + dq[1] * dq[1];
+        velocity_sq[1] += dq[2] * dq[2];
+
+        if (plant_step(truth, q, qd, ctl.tau, dt) != 0) {
+            fprintf(stderr, "control_loop: the plant reached a singular pose at t = %g s\n", t);
+            free(latency);
+            return 1;
+        }
+        reference(ctl.amplitude, t + dt, q_d, qd_d, qdd_d);
+        add(&overall, hypot(q[0] - q_d[0], q[1] - q_d[1]), fabs(q[2] - q_d[2]));
+        if (step >= transient) {
+            add(&after, hypot(q[0] - q_d[0], q[1] - q_d[1]), fabs(q[2] - q_d[2]));
+        }
     }
-    qsort(latency, (size_t)steps, sizeof *latency, compare);
-    printf("trajectory %s, %ld steps at %d Hz, %s actuation, plant masses off by 3-5%%\n", name,
-           steps, RATE_HZ, RPR3_ACTUATION);
-    printf("tracking error: position max %.4f mm, rms %.4f mm, final %.4f mm; angle max %.4f mrad\n",
-           max_pos * 1e3, sqrt(sum_pos / steps) * 1e3, final_pos * 1e3, max_ang * 1e3);
-    printf("rpr3_inverse_dynamics latency: p50 %.0f ns, p99 %.0f ns, max %.0f ns; failed calls %ld\n",
-           latency[steps / 2], latency[(long)(0.99 * (steps - 1))], latency[steps - 1], failed);
+
+    printf("trajectory %s, %ld ticks at %d Hz, %s actuation, start offset (%.3f, %.3f) mm\n",
+           name, steps, RATE_HZ, RPR3_ACTUATION, offset, 0.0 - offset);
+    if (revolute) {
+        printf("plant: masses and inertias off by 3-5%%, RK4 at %d Hz; encoders %d counts/rev "
+               "(%.1f urad/count), rates from count differences, low-pass %g Hz\n",
+               SUBSTEPS * RATE_HZ, COUNTS_PER_REV, ctl.resolution * 1e6, RATE_CUTOFF_HZ);
+    } else {
+        printf("plant: masses and inertias off by 3-5%%, RK4 at %d Hz; encoders %g um/count, "
+               "rates from count differences, low-pass %g Hz\n",
+               SUBSTEPS * RATE_HZ, METRES_PER_COUNT * 1e6, RATE_CUTOFF_HZ);
+    }
+    if (after.n > 0) {
+        printf("tracking error after %g ms: position rms %.4f mm, max %.4f mm; angle rms %.4f "
+               "mrad, max %.4f mrad\n",
+               TRANSIENT * 1e3, sqrt(after.sum[0] / after.n) * 1e3, after.max[0] * 1e3,
+               sqrt(after.sum[1] / after.n) * 1e3, after.max[1] * 1e3);
+    }
+    printf("tracking error overall: position rms %.4f mm, max %.4f mm; angle rms %.4f mrad, max "
+           "%.4f mrad\n",
+           sqrt(overall.sum[0] / overall.n) * 1e3, overall.max[0] * 1e3,
+           sqrt(overall.sum[1] / overall.n) * 1e3, overall.max[1] * 1e3);
+    printf("estimate error: pose max %.4f mm, %.4f mrad; velocity rms %.3f mm/s, %.3f mrad/s\n",
+           estimate.max[0] * 1e3, estimate.max[1] * 1e3, sqrt(velocity_sq[0] / steps) * 1e3,
+           sqrt(velocity_sq[1] / steps) * 1e3);
+    printf("efforts: rms %.3f %s; change per tick rms %.4f %s, max %.4f %s\n",
+           sqrt(tau_sq / (3.0 * steps)), unit, steps > 1 ? sqrt(dtau_sq / (3.0 * (steps - 1))) : 0.0,
+           unit, dtau_max, unit);
+    printf("failed calls: forward kinematics %ld, jacobian %ld, dynamics %ld\n", ctl.failed_fk,
+           ctl.failed_jacobian, ctl.failed_dynamics);
+    print_latency("forward kinematics", latency, steps);
+    print_latency("dynamics", latency + steps, steps);
+    print_latency("whole tick", latency + 2 * steps, steps);
     free(latency);
-    return failed ? 1 : 0;
+    return ctl.failed_fk || ctl.failed_jacobian || ctl.failed_dynamics ? 1 : 0;
 }
