@@ -1,11 +1,17 @@
-"""The 1 kHz computed-torque loop of control_loop.c, in Python, with rpr3gen.SampleEvaluator.
+"""The 1 kHz task-space computed-torque loop of control_loop.c, closed on encoders, in Python.
 
-The controller evaluates the generated C inverse dynamics of the nominal model for the desired
-acceleration plus a PD correction; the plant is the same robot with masses and inertias a few
-percent off, integrated from the actuator loads. Prints the tracking error and the latency
-distribution of the controller's call.
+The plant is the robot with masses and inertias a few percent off, integrated by RK4 of the
+generated forward dynamics (four substeps per tick). The controller reads only the quantised
+actuator positions, estimates the actuator rates from the differences of the counts (low-pass
+filtered), reconstructs the pose by tracked forward kinematics and the velocity through the
+actuator Jacobian, and commands tau = J^-T (M (qdd_d + Kd e' + Kp e) + c) from the nominal
+model's task-space dynamics. Every generated function is called through
+rpr3gen.SampleEvaluator (the generated C, preallocated buffers). Prints the tracking error, the
+failed calls and the latency (p50, p99, max) of the forward kinematics, the dynamics and the
+whole controller tick.
 
-    python control_loop.py [--model FILE] [--trajectory rectilinear|rotation] [--seconds T]
+    python control_loop.py [--model FILE] [--actuation revolute|prismatic]
+                           [--trajectory rectilinear|rotation] [--seconds T] [--offset MM]
 """
 
 from __future__ import annotations
@@ -19,95 +25,230 @@ import numpy as np
 
 import rpr3gen
 
-RATE_HZ = 1000
-SUBSTEPS = 4
-KP, KD = 900.0, 60.0
+RATE_HZ = 1000  # controller ticks per second
+SUBSTEPS = 4  # RK4 steps of the plant per tick (4 kHz)
+KP, KD = 900.0, 60.0  # s^-2, s^-1: critically damped at 30 rad/s
+RATE_CUTOFF_HZ = 100.0  # first-order low-pass on the differenced counts
+TRANSIENT = 0.05  # s, left out of the "after" tracking error
+COUNTS_PER_REV = 2**17  # revolute actuation: angle encoders
+METRES_PER_COUNT = 1e-6  # prismatic actuation: linear encoders
+DURATION = 3.0  # s, the paper's motions (eq. 3)
 PERTURBED = {"m1": 1.03, "m2": 0.96, "m3": 1.05, "J1": 1.04, "J2": 0.97, "J3": 1.05}
 
 
-def reference(amplitude: np.ndarray, t: float, duration: float) -> tuple[np.ndarray, ...]:
-    """Paper eq. (3) and its derivatives."""
-    w = math.pi / duration
+def reference(amplitude: np.ndarray, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Paper eq. (3), q = q* (1 - cos(pi t / T)), and its first two derivatives."""
+    w = math.pi / DURATION
     return (
-        amplitude * (1 - math.cos(w * t)),
-        amplitude * w * math.sin(w * t),
-        amplitude * w * w * math.cos(w * t),
+        amplitude * (1.0 - math.cos(w * t)),
+        amplitude * (w * math.sin(w * t)),
+        amplitude * (w * w * math.cos(w * t)),
     )
 
 
-def forward_dynamics(
-    plant: rpr3gen.SampleEvaluator, actuator: list[int], tau: np.ndarray
-) -> np.ndarray:
-    """Platform acceleration from the actuator loads, tau = A qdd + b (plant.q, plant.qd set)."""
-    plant.qdd[:] = 0.0
-    if plant():
-        raise RuntimeError("the plant reached a singular pose")
-    bias = plant.out[actuator].copy()
-    a = np.empty((3, 3))
-    for j in range(3):
-        plant.qdd[:] = 0.0
-        plant.qdd[j] = 1.0
-        if plant():
-            raise RuntimeError("the plant reached a singular pose")
-        a[:, j] = plant.out[actuator] - bias
-    return np.linalg.solve(a, tau - bias)
+class Plant:
+    """The true robot: state (q, qd) of the platform, RK4 of the generated forward dynamics."""
+
+    def __init__(self, truth: rpr3gen.Model, q: np.ndarray, resolution: float):
+        self.dynamics = rpr3gen.SampleEvaluator(truth, function="forward_dynamics")
+        self.coordinates = rpr3gen.SampleEvaluator(truth, function="actuator_coordinates")
+        self.q, self.qd = q.astype(float), np.zeros(3)
+        self.resolution = resolution
+
+    def _acceleration(self, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
+        fd = self.dynamics
+        fd.q[:], fd.qd[:] = q, qd
+        if fd():
+            raise RuntimeError(f"the plant reached a singular pose, q = {q.tolist()}")
+        return fd.qdd.copy()
+
+    def step(self, tau: np.ndarray, dt: float) -> None:
+        """Advance by dt under the constant efforts tau (zero-order hold), RK4 in substeps."""
+        self.dynamics.tau[:] = tau
+        h = dt / SUBSTEPS
+        q, qd = self.q, self.qd
+        for _ in range(SUBSTEPS):
+            a1 = self._acceleration(q, qd)
+            v2 = qd + 0.5 * h * a1
+            a2 = self._acceleration(q + 0.5 * h * qd, v2)
+            v3 = qd + 0.5 * h * a2
+            a3 = self._acceleration(q + 0.5 * h * v2, v3)
+            v4 = qd + h * a3
+            a4 = self._acceleration(q + h * v3, v4)
+            q = q + h / 6.0 * (qd + 2.0 * v2 + 2.0 * v3 + v4)
+            qd = qd + h / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4)
+        self.q, self.qd = q, qd
+
+    def encoders(self) -> np.ndarray:
+        """The encoder counts: the actuator coordinates rounded to whole counts."""
+        self.coordinates.q[:] = self.q
+        if self.coordinates():
+            raise RuntimeError(f"the plant reached a singular pose, q = {self.q.tolist()}")
+        return np.rint(self.coordinates.qa / self.resolution)
 
 
-def main() -> None:
+class Controller:
+    """Encoder counts in, actuator efforts out; the nominal model's generated C functions."""
+
+    def __init__(self, model: rpr3gen.Model, resolution: float, amplitude: np.ndarray):
+        self.fk = rpr3gen.SampleEvaluator(model, function="forward_kinematics")
+        self.jacobian = rpr3gen.SampleEvaluator(model, function="actuator_jacobian")
+        self.dynamics = rpr3gen.SampleEvaluator(model, function="task_space_dynamics")
+        self.resolution, self.amplitude = resolution, amplitude
+        self.alpha = 1.0 - math.exp(-2.0 * math.pi * RATE_CUTOFF_HZ / RATE_HZ)
+        self.q1 = np.zeros(3)  # the last two pose estimates; the robot was parked at home
+        self.q2 = np.zeros(3)
+        self.counts: np.ndarray | None = None
+        self.rate = np.zeros(3)  # filtered actuator rates
+        self.qd = np.zeros(3)
+        self.tau = np.zeros(3)
+        self.failed = {"forward kinematics": 0, "jacobian": 0, "dynamics": 0}
+        self.latency = {"forward kinematics": 0, "dynamics": 0}
+
+    def tick(self, counts: np.ndarray, t: float) -> np.ndarray:
+        clock = time.perf_counter_ns
+        dt = 1.0 / RATE_HZ
+        # actuator positions and rates from the counts
+        qa = counts * self.resolution
+        if self.counts is not None:
+            raw = (counts - self.counts) * (self.resolution / dt)
+            self.rate += self.alpha * (raw - self.rate)
+        self.counts = counts
+        # the pose: tracked forward kinematics from the constant-velocity prediction
+        fk = self.fk
+        fk.qa[:] = qa
+        fk.q_near[:] = 2.0 * self.q1 - self.q2
+        start = clock()
+        status = fk()
+        self.latency["forward kinematics"] = clock() - start
+        if status:
+            self.failed["forward kinematics"] += 1
+            fk.q[:] = fk.q_near  # coast on the prediction
+        q = fk.q.copy()
+        self.q2, self.q1 = self.q1, q
+        # the velocity: J qd = qa'
+        self.jacobian.q[:] = q
+        J = self.jacobian.J.reshape(3, 3)
+        try:
+            if self.jacobian():
+                raise np.linalg.LinAlgError
+            self.qd = np.linalg.solve(J, self.rate)
+        except np.linalg.LinAlgError:
+            self.failed["jacobian"] += 1
+            self.latency["dynamics"] = 0
+            return self.tau  # hold the last efforts
+        # computed torque in task space: J^T tau = M (qdd_d + Kd e' + Kp e) + c
+        q_d, qd_d, qdd_d = reference(self.amplitude, t)
+        acc = qdd_d + KD * (qd_d - self.qd) + KP * (q_d - q)
+        dyn = self.dynamics
+        dyn.q[:], dyn.qd[:] = q, self.qd
+        start = clock()
+        status = dyn()
+        if status == 0:
+            try:
+                self.tau = np.linalg.solve(J.T, dyn.M.reshape(3, 3) @ acc + dyn.c)
+            except np.linalg.LinAlgError:
+                status = -1
+        self.latency["dynamics"] = clock() - start
+        if status:
+            self.failed["dynamics"] += 1
+        return self.tau
+
+
+def percentiles(ns: np.ndarray) -> tuple[float, float, float]:
+    """p50, p99 and max, as control_loop.c picks them (ranks n/2 and 0.99 (n - 1) of the sorted)."""
+    s = np.sort(ns)
+    return float(s[len(s) // 2]), float(s[int(0.99 * (len(s) - 1))]), float(s[-1])
+
+
+def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--model")
+    parser.add_argument("--model", help="model file (default: the paper robot)")
+    parser.add_argument("--actuation", choices=["revolute", "prismatic"],
+                        help="override the model's actuation")  # fmt: skip
     parser.add_argument("--trajectory", choices=sorted(rpr3gen.trajectory.PAPER_TRAJECTORIES),
                         default="rectilinear")  # fmt: skip
-    parser.add_argument("--seconds", type=float, default=3.0)
+    parser.add_argument("--seconds", type=float, default=DURATION)
+    parser.add_argument("--offset", type=float, default=0.0, metavar="MM",
+                        help="start the plant MM millimetres off in x and -MM in y")  # fmt: skip
     args = parser.parse_args()
+    if not args.seconds > 0:
+        parser.error("--seconds must be positive")
 
     model = rpr3gen.load_model(args.model)
-    true_params = {k: v * PERTURBED.get(k, 1.0) for k, v in model.params.items()}
-    truth = dataclasses.replace(model, params=true_params)
-    controller = rpr3gen.SampleEvaluator(model)
-    plant = rpr3gen.SampleEvaluator(truth)
-    family = "m10" if model.actuation == "revolute" else "f21z"
-    actuator = [controller.index[f"{family}_{leg}"] for leg in "ABC"]
+    if args.actuation:
+        model = dataclasses.replace(model, actuation=args.actuation)
+    truth = dataclasses.replace(
+        model, params={k: v * PERTURBED.get(k, 1.0) for k, v in model.params.items()}
+    )
+    revolute = model.actuation == "revolute"
+    resolution = 2.0 * math.pi / COUNTS_PER_REV if revolute else METRES_PER_COUNT
     amplitude = np.array(rpr3gen.trajectory.PAPER_TRAJECTORIES[args.trajectory])
+    plant = Plant(truth, np.array([1e-3, -1e-3, 0.0]) * args.offset, resolution)
+    controller = Controller(model, resolution, amplitude)
 
-    duration, dt = 3.0, 1.0 / RATE_HZ
+    dt = 1.0 / RATE_HZ
     steps = round(args.seconds * RATE_HZ)
-    q, qd = np.array([0.001, -0.001, 0.0]), np.zeros(3)
-    latency = np.empty(steps)
-    errors = np.empty((steps, 2))
+    latency = np.empty((steps, 3))
+    error = np.empty((steps, 2))  # position (m), angle (rad), at the end of each tick
+    estimate = np.empty((steps, 2))  # pose estimate vs plant, at each tick's reading
+    velocity = np.empty((steps, 3))  # velocity estimate vs plant
+    efforts = np.empty((steps, 3))
     clock = time.perf_counter_ns
     for step in range(steps):
         t = step * dt
-        q_des, qd_des, qdd_des = reference(amplitude, t, duration)
-        controller.q[:] = q
-        controller.qd[:] = qd
-        controller.qdd[:] = qdd_des + KD * (qd_des - qd) + KP * (q_des - q)
+        counts = plant.encoders()
         start = clock()
-        status = controller()
-        latency[step] = clock() - start
-        if status:
-            raise RuntimeError(f"controller call failed at t = {t} s: {status}")
-        tau = controller.out[actuator].copy()
-        for _ in range(SUBSTEPS):
-            plant.q[:] = q
-            plant.qd[:] = qd
-            qd = qd + forward_dynamics(plant, actuator, tau) * dt / SUBSTEPS
-            q = q + qd * dt / SUBSTEPS
-        q_des, _, _ = reference(amplitude, t + dt, duration)
-        errors[step] = math.hypot(*(q - q_des)[:2]), abs(q[2] - q_des[2])
-    p50, p99 = np.percentile(latency, [50, 99])
-    print(f"trajectory {args.trajectory}, {steps} steps at {RATE_HZ} Hz, {model.actuation} "
-          "actuation, plant masses off by 3-5%")  # fmt: skip
+        tau = controller.tick(counts, t)
+        latency[step, 2] = clock() - start
+        latency[step, :2] = list(controller.latency.values())
+        d = controller.q1 - plant.q
+        estimate[step] = math.hypot(d[0], d[1]), abs(d[2])
+        velocity[step] = controller.qd - plant.qd
+        efforts[step] = tau
+        plant.step(tau, dt)
+        d = plant.q - reference(amplitude, t + dt)[0]
+        error[step] = math.hypot(d[0], d[1]), abs(d[2])
+
+    if revolute:
+        sensor = f"{COUNTS_PER_REV} counts/rev ({resolution * 1e6:.1f} urad/count)"
+    else:
+        sensor = f"{METRES_PER_COUNT * 1e6:g} um/count"
+    print(f"trajectory {args.trajectory}, {steps} ticks at {RATE_HZ} Hz, {model.actuation} "
+          f"actuation, start offset ({args.offset:.3f}, {0.0 - args.offset:.3f}) mm")  # fmt: skip
+    print(f"plant: masses and inertias off by 3-5%, RK4 at {SUBSTEPS * RATE_HZ} Hz; encoders "
+          f"{sensor}, rates from count differences, low-pass {RATE_CUTOFF_HZ:g} Hz")  # fmt: skip
+    after = error[round(TRANSIENT * RATE_HZ) :]
+    for label, e in ((f"after {TRANSIENT * 1e3:g} ms", after), ("overall", error)):
+        if len(e) == 0:
+            continue
+        print(
+            f"tracking error {label}: position rms {math.sqrt(np.mean(e[:, 0] ** 2)) * 1e3:.4f}"
+            f" mm, max {e[:, 0].max() * 1e3:.4f} mm; angle rms "
+            f"{math.sqrt(np.mean(e[:, 1] ** 2)) * 1e3:.4f} mrad, max {e[:, 1].max() * 1e3:.4f} mrad"
+        )
     print(
-        f"tracking error: position max {errors[:, 0].max() * 1e3:.4f} mm, "
-        f"rms {math.sqrt(np.mean(errors[:, 0] ** 2)) * 1e3:.4f} mm, "
-        f"final {errors[-1, 0] * 1e3:.4f} mm; angle max {errors[:, 1].max() * 1e3:.4f} mrad"
+        f"estimate error: pose max {estimate[:, 0].max() * 1e3:.4f} mm, "
+        f"{estimate[:, 1].max() * 1e3:.4f} mrad; velocity rms "
+        f"{math.sqrt(np.mean(np.sum(velocity[:, :2] ** 2, axis=1))) * 1e3:.3f} mm/s, "
+        f"{math.sqrt(np.mean(velocity[:, 2] ** 2)) * 1e3:.3f} mrad/s"
     )
+    unit = "N m" if revolute else "N"
+    change = np.abs(np.diff(efforts, axis=0))
     print(
-        f"SampleEvaluator call latency: p50 {p50 / 1e3:.2f} us, p99 {p99 / 1e3:.2f} us, "
-        f"max {latency.max() / 1e3:.2f} us"
+        f"efforts: rms {math.sqrt(np.mean(efforts**2)):.3f} {unit}; change per tick rms "
+        f"{math.sqrt(np.mean(change**2)) if len(change) else 0.0:.4f} {unit}, "
+        f"max {change.max() if len(change) else 0.0:.4f} {unit}"
     )
+    print("failed calls: " + ", ".join(f"{k} {v}" for k, v in controller.failed.items()))
+    for k, label in enumerate(("forward kinematics", "dynamics", "whole tick")):
+        p50, p99, worst = percentiles(latency[:, k])
+        print(
+            f"latency {label}: p50 {p50 / 1e3:.2f} us, p99 {p99 / 1e3:.2f} us, "
+            f"max {worst / 1e3:.2f} us"
+        )
+    return 1 if any(controller.failed.values()) else 0
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(main())
