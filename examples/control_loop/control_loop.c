@@ -191,7 +191,7 @@ struct controller {
     double amplitude[3];  /* of the trajectory, eq. (3) */
     double resolution;    /* rad or m per count */
     double alpha;         /* of the rate filter */
-    double q1[3], q2[3];  /* the last two pose estimates */
+    double q1[3], q2[3];  /* the last two pose estimates (home before the first) */
     long counts[3];       /* the previous reading */
     int started;
     double rate[3];       /* filtered actuator rates */
@@ -207,11 +207,12 @@ static void controller_tick(struct controller *ctl, const long *counts, double t
     const double dt = 1.0 / RATE_HZ;
     double qa[3], near[3], q[3], J[9], M[9], c[3], f[3], q_d[3], qd_d[3], qdd_d[3], acc[3];
     double start;
+    const int first = !ctl->started;
     int status, i, k;
 
     for (k = 0; k < 3; ++k) { /* actuator positions and rates from the counts */
         qa[k] = counts[k] * ctl->resolution;
-        if (ctl->started) {
+        if (!first) {
             const double raw = (counts[k] - ctl->counts[k]) * (ctl->resolution / dt);
             ctl->rate[k] += ctl->alpha * (raw - ctl->rate[k]);
         }
@@ -227,7 +228,7 @@ static void controller_tick(struct controller *ctl, const long *counts, double t
         ++ctl->failed_fk;
         memcpy(q, near, sizeof q); /* coast on the prediction */
     }
-    memcpy(ctl->q2, ctl->q1, sizeof q);
+    memcpy(ctl->q2, first ? q : ctl->q1, sizeof q); /* at first, at rest */
     memcpy(ctl->q1, q, sizeof q);
 
     if (rpr3_actuator_jacobian(ctl->params, q, J) != RPR3_OK

@@ -110,7 +110,8 @@ class Controller:
         dt = 1.0 / RATE_HZ
         # actuator positions and rates from the counts
         qa = counts * self.resolution
-        if self.counts is not None:
+        first = self.counts is None
+        if not first:
             raw = (counts - self.counts) * (self.resolution / dt)
             self.rate += self.alpha * (raw - self.rate)
         self.counts = counts
@@ -125,7 +126,7 @@ class Controller:
             self.failed["forward kinematics"] += 1
             fk.q[:] = fk.q_near  # coast on the prediction
         q = fk.q.copy()
-        self.q2, self.q1 = self.q1, q
+        self.q2, self.q1 = (q if first else self.q1), q  # at first, at rest
         # the velocity: J qd = qa'
         self.jacobian.q[:] = q
         J = self.jacobian.J.reshape(3, 3)
