@@ -123,10 +123,16 @@ def test_c_and_python_close_the_same_loop(repo_root: Path, c_build: Path) -> Non
     assert c == pytest.approx(py, abs=2e-4)  # same plant, sensors and law; 4 decimals printed
 
 
-def test_c_control_loop_start_offset(c_build: Path) -> None:
-    """The plant starts 1 mm off in x and -1 mm in y; the controller's first reference is home."""
+def test_c_control_loop_start_offset(repo_root: Path, c_build: Path) -> None:
+    """The plant starts 1 mm off in x and -1 mm in y; the controller's first reference is home.
+
+    The example's README explains the largest error this prints: the start itself.
+    """
     text = _run_c(c_build, "revolute", "rectilinear", "0.4", "1")
     assert "start offset (1.000, -1.000) mm" in text, text
     numbers = _report(text)  # no failed forward kinematics from 1.4 mm off
     assert numbers["overall pos_max"] == pytest.approx(2**0.5, abs=0.01), text  # the offset
     assert numbers["estimate mm"] < ESTIMATE_BOUND_MM["revolute"], text
+    readme = (repo_root / "examples" / "control_loop" / "README.md").read_text(encoding="utf-8")
+    assert "starts 1 mm off in x" in readme
+    assert f"largest position error, {numbers['overall pos_max']:.4f} mm" in readme
