@@ -42,12 +42,6 @@ def test_notebooks_extra_brings_a_jupyter_front_end(repo_root: Path) -> None:
     assert "'.[notebooks]'" in (repo_root / "README.md").read_text(encoding="utf-8")
 
 
-def test_control_loop_readme_explains_the_printed_error(repo_root: Path) -> None:
-    text = (repo_root / "examples" / "control_loop" / "README.md").read_text(encoding="utf-8")
-    assert "1.4135 mm" in text
-    assert "starts 1 mm off in x" in text
-
-
 def test_quick_benchmark_run_keeps_the_committed_full_results(
     repo_root: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
