@@ -24,6 +24,9 @@ class CPrinter(C99CodePrinter):
         return f"(({x}) - {TWO_PI}*nearbyint(({x})*{INV_TWO_PI}))"
 
 
+_PRINTER = CPrinter()  # stateless between calls; built once, it is most of a call's cost
+
+
 def c_code(expr: sp.Expr) -> str:
     """One C99 expression."""
-    return CPrinter().doprint(prepare(expr))
+    return _PRINTER.doprint(prepare(expr))

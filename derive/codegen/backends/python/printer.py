@@ -23,6 +23,9 @@ class NumpyPrinter(NumPyPrinter):
         return f"(({x}) - {TWO_PI}*numpy.rint(({x})*{INV_TWO_PI}))"
 
 
+_PRINTER = NumpyPrinter()  # stateless between calls; built once, it is most of a call's cost
+
+
 def numpy_code(expr: sp.Expr) -> str:
     """One NumPy expression."""
-    return NumpyPrinter().doprint(prepare(expr))
+    return _PRINTER.doprint(prepare(expr))
