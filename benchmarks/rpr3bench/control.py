@@ -212,14 +212,17 @@ def _c_table(runs: dict[tuple[str, str], Any]) -> tuple[str, dict[str, Any]]:
         "conditioning guard (*floor: sin, cos, 4 sqrt*); the inverse dynamics and the revolute "
         "actuator coordinates add the 3 atan2 of the leg angles. *vs floor* divides the "
         "function's median by its floor's. The forward kinematics and the ticks have no floor "
-        "(iterative): one tracked call that takes one Newton step (the case here, next table) "
+        "(iterative): one tracked call that takes one Newton step (the case here: see *FK Newton "
+        "steps* below) "
         "evaluates the actuator coordinates twice (the residual at q_near and after the step) "
         "and the Jacobian three times (the step, and det J at q_near and at the result for the "
         "aspect test); those single calls add up to "
         + " / ".join(f"{sums[a]:.0f}" for a in ACTUATIONS)
         + " ns (revolute / prismatic), against the measured "
         + " / ".join(f"{_med(o3[a], 'fk_predicted') or 0:.0f}" for a in ACTUATIONS)
-        + ". The tick's calls (tracked FK, J, task-space dynamics) add up to "
+        + "; the rest is the Newton algebra and the acceptance test's own libm calls (revolute: "
+        "sin and cos of phi and of the three leg angles). The tick's calls (tracked FK, J, "
+        "task-space dynamics) add up to "
         + " / ".join(f"{parts[a]:.0f}" for a in ACTUATIONS)
         + " ns; the rest of the tick is its 3x3 algebra and the dependency between ticks.\n"
     )
@@ -272,7 +275,7 @@ def _c_checks(runs: dict[tuple[str, str], Any]) -> tuple[str, dict[str, Any]]:
                 "build",
                 "trajectory",
                 "max abs. error",
-                "max |q''|",
+                "max \\|q''\\|",
                 "relative error",
                 "goal 1e-12",
                 "failed calls",
