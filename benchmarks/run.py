@@ -1,10 +1,12 @@
-"""Benchmarks of rpr3gen: regeneration, the NumPy and C backends, the Python call path, and peers.
+"""Benchmarks of rpr3gen: regeneration, NumPy and C backends, Python calls, peers, control model.
 
 Run from anywhere with the project's interpreter (rpr3gen installed with the ``dev`` extra)::
 
     python benchmarks/run.py                # full run; writes benchmarks/results.md
     python benchmarks/run.py --quick        # fewer repeats, no 10^7 samples; results-quick.md
     python benchmarks/run.py --out FILE.md  # write the Markdown elsewhere
+    python benchmarks/run.py --only control # one section (several: --only c --only python);
+                                            # writes benchmarks/results-only-control.md
 
 It prints the report (Markdown) on stdout, progress on stderr, and writes the same Markdown to
 ``--out``. The measurements live in the package ``rpr3bench`` beside this file (``workers``:
@@ -25,10 +27,16 @@ from rpr3bench import report, sections, workers
 from rpr3bench.common import BENCH, log
 
 
-def report_path(out: str | None, quick: bool) -> Path:
+def report_path(out: str | None, quick: bool, only: list[str] | None = None) -> Path:
     """Where the report goes: ``--out``, else ``results.md``, or ``results-quick.md`` with
-    ``--quick``, so that a quick run never replaces the committed full results."""
-    return Path(out) if out else BENCH / ("results-quick.md" if quick else "results.md")
+    ``--quick``, or ``results-only-KEY[-quick].md`` with ``--only``, so that neither a quick
+    nor a partial run replaces the committed full results."""
+    if out:
+        return Path(out)
+    if only:
+        keys = [key for key in sections.SECTIONS if key in only]
+        return BENCH / f"results-only-{'-'.join(keys)}{'-quick' if quick else ''}.md"
+    return BENCH / ("results-quick.md" if quick else "results.md")
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -39,6 +47,13 @@ def main(argv: Sequence[str] | None = None) -> int:
         help="Markdown report file (default: benchmarks/results.md, with --quick "
         "benchmarks/results-quick.md)",
     )
+    parser.add_argument(
+        "--only",
+        action="append",
+        choices=list(sections.SECTIONS),
+        help="run only this section (repeat for several): "
+        + ", ".join(f"{key} ({title})" for key, title in sections.SECTIONS.items()),
+    )
     parser.add_argument("--worker", help=argparse.SUPPRESS)  # one measurement, in this process
     parser.add_argument("--args", default="{}", help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
@@ -48,13 +63,17 @@ def main(argv: Sequence[str] | None = None) -> int:
 
     started = time.perf_counter()
     info = report.machine()
-    parts, results = sections.run_all(args.quick)
+    parts, results = sections.run_all(args.quick, args.only)
     info["load average (end)"] = report.loadavg()
-    info["run"] = f"{'--quick' if args.quick else 'full'}, {time.perf_counter() - started:.0f} s"
+    kind = "--quick" if args.quick else "full"
+    if args.only:
+        kind += ", only " + ", ".join(args.only)
+    info["run"] = f"{kind}, {time.perf_counter() - started:.0f} s"
     command = "python benchmarks/run.py" + (" --quick" if args.quick else "")
+    command += "".join(f" --only {key}" for key in args.only or [])
     text = report.document(command, info, results, parts)
     print(text)
-    out = report_path(args.out, args.quick)
+    out = report_path(args.out, args.quick, args.only)
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(text)
     log(f"wrote {out}")

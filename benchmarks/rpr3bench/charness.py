@@ -205,3 +205,161 @@ def run(n: int, repeats: int) -> CRun | str:
                 + f"; libmvec (`_ZGV*`) symbols used: {fast_symbols}"
             )
     return result
+
+
+# ---------------------------------------------------------------------------------------------
+# The control model: bench_control.c (both variants, two builds) and the MuJoCo peer from C
+# ---------------------------------------------------------------------------------------------
+
+CONTROL_SOURCE = BENCH / "bench_control.c"
+MUJOCO_SOURCE = BENCH / "bench_mujoco.c"
+#: Builds of bench_control.c: the runtime's flags (``cbackend.CFLAGS`` and its first
+#: ``EXTRA_FLAGS``, without ``-fPIC -shared``), and plain -O2 as in examples/control_loop.
+CONTROL_BUILDS: dict[str, tuple[str, ...]] = {
+    "O3": ("-std=c99", "-O3", "-march=native", "-fno-tree-slp-vectorize"),
+    "O2": ("-std=c99", "-O2"),
+}
+#: The paper's trajectories the control harness runs, one after the other, each sampled at 1 ms.
+CONTROL_TRAJECTORIES = ("rotation", "rectilinear")
+CONTROL_SAMPLES = 3001  # 3 s at 1 ms
+
+
+#: libm functions counted in the kernels of the control functions.
+LIBM = ("sin", "cos", "sqrt", "atan2", "atan", "pow", "exp", "log")
+
+
+def kernel_calls(actuation: str) -> dict[str, dict[str, int]]:
+    """libm calls (:data:`LIBM`) in the body of each ``rpr3_NAME_kernel`` of a variant's
+    generated C, by NAME."""
+    from rpr3gen import manifest
+
+    source = manifest.load(actuation).path("c_source").read_text()
+    kernels = re.finditer(r"^static int rpr3_(\w+)_kernel\(", source, re.M)
+    calls = {}
+    for match in kernels:
+        end = source.find("\nint rpr3_", match.start())
+        body = source[match.start() : end if end > 0 else None]
+        calls[match.group(1)] = {
+            f: len(re.findall(rf"\b{f}\(", body)) for f in LIBM if re.search(rf"\b{f}\(", body)
+        }
+    return calls
+
+
+def control_inputs(build: Path) -> tuple[Path, Path, int, int]:
+    """Write ``rpr3gen params`` and the trajectories (raw q, qd, qdd) for bench_control.c:
+    (params file, samples file, samples, samples per trajectory)."""
+    import numpy as np
+
+    import rpr3gen
+
+    done = subprocess.run(
+        [PY, "-m", "rpr3gen.cli", "params"], capture_output=True, text=True, check=True
+    )
+    params_file = build / "params.txt"
+    params_file.write_text(done.stdout)
+    runs = [
+        rpr3gen.paper_trajectory(name, samples=CONTROL_SAMPLES, duration=3.0)
+        for name in CONTROL_TRAJECTORIES
+    ]
+    arrays = [np.concatenate([getattr(r, k) for r in runs]) for k in ("q", "qd", "qdd")]
+    samples = build / "control.bin"
+    np.concatenate([a.ravel() for a in arrays]).astype("=f8").tofile(samples)
+    return params_file, samples, len(arrays[0]), CONTROL_SAMPLES
+
+
+def _build_and_run(
+    command: list[str], exe: Path, args: Sequence[str], what: str
+) -> dict[str, Any] | str:
+    log(f"{what}: " + " ".join(command))
+    done = subprocess.run(command, capture_output=True, text=True, check=False, cwd=REPO)
+    if done.returncode != 0:
+        return f"Compiling {what} failed:\n\n```\n{done.stderr}\n```\n"
+    done = subprocess.run([str(exe), *args], capture_output=True, text=True, check=False)
+    if done.returncode != 0:
+        return f"{what} failed: {done.stderr.strip()}\n"
+    return _parse(done.stdout)[0]
+
+
+def run_control(build: Path, actuation: str, flags: str, repeats: int) -> dict[str, Any] | str:
+    """Build bench_control.c against one variant with ``CONTROL_BUILDS[flags]`` and run it on
+    the trajectories of :func:`control_inputs` (written into ``build`` once)."""
+    from rpr3gen import manifest
+
+    params_file, samples = build / "params.txt", build / "control.bin"
+    if not samples.exists():
+        control_inputs(build)
+    n = len(CONTROL_TRAJECTORIES) * CONTROL_SAMPLES
+    found = manifest.load(actuation)
+    exe = build / f"bench_control_{actuation}_{flags}"
+    command = [
+        *CC,
+        *CONTROL_BUILDS[flags],
+        "-I",
+        shown(found.folder),
+        shown(CONTROL_SOURCE),
+        shown(found.path("c_source")),
+        "-lm",
+        "-o",
+        str(exe),
+    ]
+    args = [str(params_file), str(samples), str(n), str(CONTROL_SAMPLES), str(repeats)]
+    result = _build_and_run(command, exe, args, f"bench_control ({actuation}, {flags})")
+    if isinstance(result, dict):
+        result["command"] = " ".join([*command[:-2], "-o", "bench_control"])
+    return result
+
+
+def mujoco_library() -> tuple[Path, Path] | str:
+    """(include folder, libmujoco) of the installed mujoco Python package, or why not."""
+    import importlib.util
+
+    spec = importlib.util.find_spec("mujoco")
+    if spec is None or not spec.origin:
+        return "the mujoco package is not installed"
+    folder = Path(spec.origin).parent
+    libraries = sorted(folder.glob("libmujoco.so*"))
+    include = folder / "include"
+    if not libraries or not (include / "mujoco" / "mujoco.h").exists():
+        return f"no C headers or libmujoco in {folder}"
+    return include, libraries[-1]
+
+
+def run_mujoco(
+    build: Path, xml: Path, state: Path, calls: int, repeats: int
+) -> dict[str, Any] | str:
+    """Build bench_mujoco.c against the mujoco package's library and time mj_forward and
+    mj_step from C on the model ``xml`` at the state ``state``."""
+    found = mujoco_library()
+    if isinstance(found, str):
+        return found
+    include, library = found
+    exe = build / "bench_mujoco"
+    command = [
+        *CC,
+        "-std=c11",
+        "-O2",
+        "-I",
+        str(include),
+        shown(MUJOCO_SOURCE),
+        str(library),
+        f"-Wl,-rpath,{library.parent}",
+        "-o",
+        str(exe),
+    ]
+    result = _build_and_run(
+        command, exe, [str(xml), str(state), str(calls), str(repeats)], "bench_mujoco"
+    )
+    if isinstance(result, dict):
+        result["command"] = " ".join(
+            [
+                *CC,
+                "-std=c11",
+                "-O2",
+                "-I .../mujoco/include",
+                shown(MUJOCO_SOURCE),
+                f".../mujoco/{library.name}",
+                "-o",
+                "bench_mujoco",
+            ]
+        )
+    return result

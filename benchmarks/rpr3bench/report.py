@@ -26,6 +26,11 @@ TARGETS = {
     "numpy_1e6_ns": 500.0,  # NumPy at 10^6 samples < 500 ns/sample
     "python_single_us": 1.0,  # SampleEvaluator call < 1 us
     "regeneration_s": 5.0,  # full regeneration < 5 s
+    # Control model (issue 12; section "Control model"):
+    "control_fd_ns": 300.0,  # C forward dynamics, one call < 300 ns
+    "control_fd_exact": 1e-12,  # forward dynamics of the ID efforts vs q'': max rel. error
+    "control_tick_ns": 1000.0,  # one control tick in C < 1 us
+    "control_python_tick_us": 10.0,  # one control tick in Python < 10 us
 }
 #: The function the targets score.
 SCORED = "inverse_dynamics"
@@ -159,7 +164,7 @@ def verdict(measured: float | None, limit: float, at_most: bool = True) -> tuple
 
 
 def targets(results: dict[str, Any]) -> str:
-    """The targets table, from the results of every section."""
+    """The targets table, from the results of every section that ran."""
     c = results.get("c", {})
     floor = c.get("floor_ns")
     rows = []
@@ -201,38 +206,77 @@ def targets(results: dict[str, Any]) -> str:
             "≥ 20x faster",
             at_most=False,
         )
-    backend = results.get("numpy", {}).get(SCORED, {}).get("backend", {})
-    n6 = backend.get(10**6, {}).get("best_ns")
-    add(
-        "NumPy at 10^6 samples",
-        f"{ns(n6)} ns/sample",
-        n6,
-        TARGETS["numpy_1e6_ns"],
-        "< 500 ns/sample",
-    )
-    py = results.get("python", {}).get("functions", {}).get(SCORED, {}).get("c_call")
-    add(
-        "Python single call (`SampleEvaluator`)",
-        f"{py * 1e6:.3f} µs" if py else "n/a",
-        py * 1e6 if py else None,
-        TARGETS["python_single_us"],
-        "< 1 µs",
-    )
-    regen = results.get("regen", {})
-    add(
-        "full regeneration, `rpr3gen generate --check`",
-        f"{secs(regen.get('cli'))} s",
-        regen.get("cli"),
-        TARGETS["regeneration_s"],
-        "< 5 s",
-    )
-    add(
-        "full regeneration, `generate.render()` in process",
-        f"{secs(regen.get('total'))} s",
-        regen.get("total"),
-        TARGETS["regeneration_s"],
-        "< 5 s",
-    )
+    if "numpy" in results:
+        backend = results["numpy"].get(SCORED, {}).get("backend", {})
+        n6 = backend.get(10**6, {}).get("best_ns")
+        add(
+            "NumPy at 10^6 samples",
+            f"{ns(n6)} ns/sample",
+            n6,
+            TARGETS["numpy_1e6_ns"],
+            "< 500 ns/sample",
+        )
+    if "python" in results:
+        py = results["python"].get("functions", {}).get(SCORED, {}).get("c_call")
+        add(
+            "Python single call (`SampleEvaluator`)",
+            f"{py * 1e6:.3f} µs" if py else "n/a",
+            py * 1e6 if py else None,
+            TARGETS["python_single_us"],
+            "< 1 µs",
+        )
+    if "regen" in results:
+        regen = results["regen"]
+        add(
+            "full regeneration, `rpr3gen generate --check`",
+            f"{secs(regen.get('cli'))} s",
+            regen.get("cli"),
+            TARGETS["regeneration_s"],
+            "< 5 s",
+        )
+        add(
+            "full regeneration, `generate.render()` in process",
+            f"{secs(regen.get('total'))} s",
+            regen.get("total"),
+            TARGETS["regeneration_s"],
+            "< 5 s",
+        )
+    if "control" in results:
+        control = results["control"]
+        for actuation, value in control.get("fd_ns", {}).items():
+            add(
+                f"C forward dynamics, one call ({actuation})",
+                f"{ns(value)} ns",
+                value,
+                TARGETS["control_fd_ns"],
+                "< 300 ns",
+            )
+        err = control.get("fd_rel_err")
+        add(
+            "forward dynamics of the ID efforts vs q'' (max relative error)",
+            f"{err:.1e}" if err is not None else "n/a",
+            err,
+            TARGETS["control_fd_exact"],
+            "≤ 1e-12",
+        )
+        for actuation, value in control.get("tick_ns", {}).items():
+            add(
+                f"C control tick ({actuation})",
+                f"{ns(value)} ns",
+                value,
+                TARGETS["control_tick_ns"],
+                "< 1 µs",
+            )
+        ticks = (("python_tick_us", "`numpy.linalg.solve`"), ("python_tick_floats_us", "floats"))
+        for key, how in ticks:
+            for actuation, value in control.get(key, {}).items():
+                add(
+                    f"Python control tick, 3x3 solves by {how} ({actuation})",
+                    f"{value:.2f} µs",
+                    value,
+                    TARGETS["control_python_tick_us"],
+                    "< 10 µs",
+                )
     return table(["target", "measured", "goal", "result", "margin"], rows) + "\n"
 
 

@@ -604,18 +604,37 @@ def section_peers(quick: bool, numpy_results: dict[str, Any]) -> tuple[str, dict
     return "\n".join(text), result
 
 
-def run_all(quick: bool) -> tuple[list[tuple[str, str]], dict[str, Any]]:
-    """Every section in order: ``[(title, Markdown)]`` and the results by section."""
+#: Sections by key (``run.py --only KEY``), in order: title and what runs them.
+SECTIONS: dict[str, str] = {
+    "regen": "1. Regeneration",
+    "numpy": "2. NumPy backend",
+    "c": "3. C backend against the transcendental floor",
+    "python": "4. Python single-sample call into C",
+    "peers": "5. Peers",
+    "control": "6. Control model",
+}
+
+
+def run_all(
+    quick: bool, only: list[str] | None = None
+) -> tuple[list[tuple[str, str]], dict[str, Any]]:
+    """Every section in order (or those of ``only``): ``[(title, Markdown)]`` and the results
+    by section. A section whose input section did not run gets none (its figures say n/a)."""
+    from rpr3bench.control import section_control
+
+    runs = {
+        "regen": lambda r: section_regen(quick),
+        "numpy": lambda r: section_numpy(quick, r.get("regen", {}).get("ops", {})),
+        "c": lambda r: section_c(quick),
+        "python": lambda r: section_python(quick, r.get("c", {}).get("single_ns")),
+        "peers": lambda r: section_peers(quick, r.get("numpy", {})),
+        "control": lambda r: section_control(quick),
+    }
     results: dict[str, Any] = {}
     sections = []
-    text, results["regen"] = section_regen(quick)
-    sections.append(("1. Regeneration", text))
-    text, results["numpy"] = section_numpy(quick, results["regen"].get("ops", {}))
-    sections.append(("2. NumPy backend", text))
-    text, results["c"] = section_c(quick)
-    sections.append(("3. C backend against the transcendental floor", text))
-    text, results["python"] = section_python(quick, results["c"].get("single_ns"))
-    sections.append(("4. Python single-sample call into C", text))
-    text, results["peers"] = section_peers(quick, results["numpy"])
-    sections.append(("5. Peers", text))
+    for key, title in SECTIONS.items():
+        if only and key not in only:
+            continue
+        text, results[key] = runs[key](results)
+        sections.append((title, text))
     return sections, results

@@ -435,12 +435,363 @@ def worker_python_single(args: dict[str, Any]) -> dict[str, Any]:
     }
 
 
+# ---------------------------------------------------------------------------------------------
+# The control model (section "Control model")
+# ---------------------------------------------------------------------------------------------
+
+#: Gains of the control tick (as examples/control_loop): a = q*'' + KD (q*' - q') + KP (q* - q).
+KP, KD = 900.0, 60.0
+#: The efforts of each actuation among the outputs of the inverse dynamics.
+EFFORT = {"revolute": "m10", "prismatic": "f21z"}
+
+
+def _control_model(actuation: str) -> Any:
+    import dataclasses
+
+    import rpr3gen
+
+    return dataclasses.replace(rpr3gen.load_model(), actuation=actuation)
+
+
+def _control_samples(model: Any) -> dict[str, Any]:
+    """The paper's trajectories at 1 ms, one after the other, and what a controller reads on
+    them: encoders ``qa`` and ``qa_dot = J q'``, and the efforts ``tau`` of the inverse
+    dynamics (all through the generated C), with ``starts``, the first sample of each."""
+    import numpy as np
+
+    import rpr3gen
+    from rpr3bench.charness import CONTROL_SAMPLES, CONTROL_TRAJECTORIES
+
+    runs = [
+        rpr3gen.paper_trajectory(name, samples=CONTROL_SAMPLES, duration=3.0)
+        for name in CONTROL_TRAJECTORIES
+    ]
+    q, qd, qdd = (np.concatenate([getattr(r, k) for r in runs]) for k in ("q", "qd", "qdd"))
+    (qa,), _ = rpr3gen.evaluate(model, "actuator_coordinates", (q,), backend="c")
+    (J,), _ = rpr3gen.evaluate(model, "actuator_jacobian", (q,), backend="c")
+    (out,), _ = rpr3gen.evaluate(model, "inverse_dynamics", (q, qd, qdd), backend="c")
+    names = list(
+        rpr3gen.manifest.load(model.actuation).function("inverse_dynamics").outputs[0].names
+    )
+    effort = [names.index(f"{EFFORT[model.actuation]}_{leg}") for leg in "ABC"]
+    return {
+        "q": q,
+        "qd": qd,
+        "qdd": qdd,
+        "qa": qa,
+        "qa_dot": np.einsum("nij,nj->ni", J.reshape(-1, 3, 3), qd),
+        "tau": out[:, effort],
+        "effort": effort,
+        "starts": [k * CONTROL_SAMPLES for k in range(len(runs))],
+    }
+
+
+def _python_ticks(model: Any, data: dict[str, Any]) -> dict[str, Callable[[], Any]]:
+    """Python control ticks over the trajectories, each a function that runs one pass (every
+    sample, tracking FK from each trajectory's start) and returns the efforts (n, 3).
+
+    - ``numpy``: the generated calls (``SampleEvaluator``, c backend) and ``numpy.linalg.solve``
+      for the velocity and the torque solves;
+    - ``floats``: the same calls, the 3x3 algebra on Python floats (J^-1 by cofactors, once);
+    - ``inverse_dynamics``: FK, J, ``numpy.linalg.solve`` for q', then the generated inverse
+      dynamics at (q, q', a) in place of the task-space dynamics and the torque solve.
+    """
+    import numpy as np
+
+    import rpr3gen
+
+    fk = rpr3gen.SampleEvaluator(model, backend="c", function="forward_kinematics")
+    jac = rpr3gen.SampleEvaluator(model, backend="c", function="actuator_jacobian")
+    tsd = rpr3gen.SampleEvaluator(model, backend="c", function="task_space_dynamics")
+    idy = rpr3gen.SampleEvaluator(model, backend="c", function="inverse_dynamics")
+    J, M, c = jac.J.reshape(3, 3), tsd.M.reshape(3, 3), tsd.c
+    effort = data["effort"]
+    n = len(data["q"])
+    starts = set(data["starts"])
+    rows = {k: data[k] for k in ("q", "qd", "qdd", "qa", "qa_dot")}
+    lists = {k: v.tolist() for k, v in rows.items()}
+
+    def numpy_tick() -> Any:
+        q_des, qd_des, qdd_des, qa, qa_dot = (rows[k] for k in ("q", "qd", "qdd", "qa", "qa_dot"))
+        taus = np.empty((n, 3))
+        q1 = q2 = q_des[0]
+        for k in range(n):
+            if k in starts:
+                q1 = q2 = q_des[k]
+            fk.qa[:] = qa[k]
+            fk.q_near[:] = 2.0 * q1 - q2
+            if fk():
+                raise RuntimeError(f"forward kinematics failed at sample {k}")
+            q = fk.q.copy()
+            jac.q[:] = q
+            jac()
+            qd = np.linalg.solve(J, qa_dot[k])
+            tsd.q[:] = q
+            tsd.qd[:] = qd
+            tsd()
+            a = qdd_des[k] + KD * (qd_des[k] - qd) + KP * (q_des[k] - q)
+            taus[k] = np.linalg.solve(J.T, M @ a + c)
+            q1, q2 = q, q1
+        return taus
+
+    def floats_tick() -> Any:
+        q_des, qd_des, qdd_des, qa, qa_dot = (lists[k] for k in ("q", "qd", "qdd", "qa", "qa_dot"))
+        taus = [None] * n
+        x1 = x2 = q_des[0]
+        for k in range(n):
+            if k in starts:
+                x1 = x2 = q_des[k]
+            fk.qa[:] = qa[k]
+            fk.q_near[:] = (2 * x1[0] - x2[0], 2 * x1[1] - x2[1], 2 * x1[2] - x2[2])
+            if fk():
+                raise RuntimeError(f"forward kinematics failed at sample {k}")
+            jac.q[:] = fk.q
+            jac()
+            j0, j1, j2, j3, j4, j5, j6, j7, j8 = jac.J.tolist()
+            c0, c1, c2 = j4 * j8 - j5 * j7, j5 * j6 - j3 * j8, j3 * j7 - j4 * j6
+            c3, c4, c5 = j2 * j7 - j1 * j8, j0 * j8 - j2 * j6, j1 * j6 - j0 * j7
+            c6, c7, c8 = j1 * j5 - j2 * j4, j2 * j3 - j0 * j5, j0 * j4 - j1 * j3
+            inv = 1.0 / (j0 * c0 + j1 * c1 + j2 * c2)
+            w0, w1, w2 = qa_dot[k]
+            qd = (
+                (c0 * w0 + c3 * w1 + c6 * w2) * inv,
+                (c1 * w0 + c4 * w1 + c7 * w2) * inv,
+                (c2 * w0 + c5 * w1 + c8 * w2) * inv,
+            )
+            tsd.q[:] = fk.q
+            tsd.qd[:] = qd
+            tsd()
+            q = fk.q.tolist()
+            m0, m1, m2, m3, m4, m5, m6, m7, m8 = tsd.M.tolist()
+            b0, b1, b2 = tsd.c.tolist()
+            qs, vs, acc = q_des[k], qd_des[k], qdd_des[k]
+            a0 = acc[0] + KD * (vs[0] - qd[0]) + KP * (qs[0] - q[0])
+            a1 = acc[1] + KD * (vs[1] - qd[1]) + KP * (qs[1] - q[1])
+            a2 = acc[2] + KD * (vs[2] - qd[2]) + KP * (qs[2] - q[2])
+            r0 = m0 * a0 + m1 * a1 + m2 * a2 + b0
+            r1 = m3 * a0 + m4 * a1 + m5 * a2 + b1
+            r2 = m6 * a0 + m7 * a1 + m8 * a2 + b2
+            taus[k] = (
+                (c0 * r0 + c1 * r1 + c2 * r2) * inv,
+                (c3 * r0 + c4 * r1 + c5 * r2) * inv,
+                (c6 * r0 + c7 * r1 + c8 * r2) * inv,
+            )
+            x1, x2 = q, x1
+        return np.array(taus)
+
+    def id_tick() -> Any:
+        q_des, qd_des, qdd_des, qa, qa_dot = (rows[k] for k in ("q", "qd", "qdd", "qa", "qa_dot"))
+        taus = np.empty((n, 3))
+        q1 = q2 = q_des[0]
+        for k in range(n):
+            if k in starts:
+                q1 = q2 = q_des[k]
+            fk.qa[:] = qa[k]
+            fk.q_near[:] = 2.0 * q1 - q2
+            if fk():
+                raise RuntimeError(f"forward kinematics failed at sample {k}")
+            q = fk.q.copy()
+            jac.q[:] = q
+            jac()
+            qd = np.linalg.solve(J, qa_dot[k])
+            idy.q[:] = q
+            idy.qd[:] = qd
+            idy.qdd[:] = qdd_des[k] + KD * (qd_des[k] - qd) + KP * (q_des[k] - q)
+            idy()
+            taus[k] = idy.out[effort]
+            q1, q2 = q, q1
+        return taus
+
+    return {"numpy": numpy_tick, "floats": floats_tick, "inverse_dynamics": id_tick}
+
+
+def worker_control_python(args: dict[str, Any]) -> dict[str, Any]:
+    """Per actuation: ``SampleEvaluator`` calls of the control functions (c backend) and the
+    Python control ticks of :func:`_python_ticks` along the paper's trajectories at 1 ms."""
+    import numpy as np
+
+    import rpr3gen
+
+    number, repeats, passes = int(args["number"]), int(args["repeats"]), int(args["passes"])
+    results: dict[str, Any] = {}
+    for actuation in args["actuations"]:
+        model = _control_model(actuation)
+        data = _control_samples(model)
+        k = len(data["q"]) // 4  # a sample in the middle of the rotation
+        near = 2 * data["q"][k - 1] - data["q"][k - 2]  # the tracked case: one Newton step
+        sample = {
+            "q": data["q"][k],
+            "qd": data["qd"][k],
+            "qdd": data["qdd"][k],
+            "tau": data["tau"][k],
+            "qa": data["qa"][k],
+            "q_near": near,
+        }
+        calls = {}
+        for name in args["functions"]:
+            ev = rpr3gen.SampleEvaluator(model, backend="c", function=name)
+            for key, buffer in ev.inputs.items():
+                buffer[:] = sample[key]
+            status = ev()
+            rejected = rpr3gen.SampleEvaluator(model, backend="c", function=name)
+            next(iter(rejected.inputs.values()))[:] = np.nan
+            calls[name] = {
+                "call": min(timeit.repeat(ev, number=number, repeat=repeats)) / number,
+                "rejected": min(timeit.repeat(rejected, number=number, repeat=repeats)) / number,
+                "status": status,
+                "rejected_status": rejected(),
+            }
+        ticks = {}
+        for name, tick in _python_ticks(model, data).items():
+            taus = tick()  # warm-up, and the check
+            times = []
+            for _ in range(passes):
+                start = time.perf_counter()
+                tick()
+                times.append((time.perf_counter() - start) / len(data["q"]))
+            err = float(np.max(np.abs(taus - data["tau"])) / np.max(np.abs(data["tau"])))
+            ticks[name] = {"times": times, "tau_err": err}
+        results[actuation] = {"calls": calls, "ticks": ticks, "samples": len(data["q"])}
+    # What one numpy.linalg.solve of a 3x3 system costs (the numpy tick makes two).
+    matrix, vector, count = np.eye(3) + 0.1 * np.arange(9.0).reshape(3, 3), np.ones(3), number // 4
+    solve = (
+        min(timeit.repeat(lambda: np.linalg.solve(matrix, vector), number=count, repeat=repeats))
+        / count
+    )
+    return {
+        "actuations": results,
+        "number": number,
+        "repeats": repeats,
+        "passes": passes,
+        "numpy_solve": solve,
+    }
+
+
+def _import_test_helper(name: str) -> Any:
+    import importlib.util
+    import sys
+
+    path = REPO / "tests" / f"{name}.py"
+    spec = importlib.util.spec_from_file_location(f"rpr3_bench_{name}", path)
+    assert spec is not None
+    assert spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module  # dataclasses look their module up by name
+    spec.loader.exec_module(module)
+    return module
+
+
+def worker_fk_iterations(args: dict[str, Any]) -> dict[str, Any]:
+    """Newton steps of the reference tracked forward kinematics (``tests/fk_reference.py``),
+    whose path the generated C follows step for step, along the paper's trajectories at 1 ms."""
+    import numpy as np
+
+    import rpr3gen
+    from rpr3bench.charness import CONTROL_SAMPLES, CONTROL_TRAJECTORIES
+
+    fk = _import_test_helper("fk_reference")
+    geom = fk.Geometry.from_params(rpr3gen.load_model().params)
+    rows = []
+    for name in CONTROL_TRAJECTORIES:
+        q = rpr3gen.paper_trajectory(name, samples=CONTROL_SAMPLES, duration=3.0).q
+        for actuation in args["actuations"]:
+            for reference in ("predicted", "previous"):
+                prev = prev2 = tuple(q[0])
+                steps, fallbacks, error = [], 0, 0.0
+                for k in range(len(q)):
+                    qa = fk.actuator_coordinates(geom, actuation, q[k])
+                    near = prev
+                    if reference == "predicted":
+                        near = tuple(2 * a - b for a, b in zip(prev, prev2, strict=True))
+                    found = fk.tracked_forward_kinematics(geom, actuation, qa, near)
+                    steps.append(found.iterations)
+                    fallbacks += found.status != "newton"
+                    error = max(error, fk.distance(geom, found.q, q[k]))
+                    prev2, prev = prev, found.q
+                rows.append(
+                    {
+                        "trajectory": name,
+                        "actuation": actuation,
+                        "reference": reference,
+                        "samples": len(q),
+                        "mean": float(np.mean(steps)),
+                        "max": int(max(steps)),
+                        "histogram": {str(s): steps.count(s) for s in sorted(set(steps))},
+                        "fallbacks": fallbacks,
+                        "error": error,
+                    }
+                )
+    return {"rows": rows}
+
+
+def worker_mujoco(args: dict[str, Any]) -> dict[str, Any]:
+    """``mj_forward`` and ``mj_step`` (RK4) of the MuJoCo peer (``tests/mujoco_peer.py``) on the
+    paper's robot, from Python (``timeit``) and from C (``bench_mujoco.c``)."""
+    import statistics
+    import tempfile
+    from pathlib import Path
+
+    try:
+        import mujoco
+    except ImportError as error:
+        return {"skipped": f"MuJoCo is not installed ({error}); `pip install -e '.[peers]'`"}
+    import rpr3gen
+    from rpr3bench import charness
+
+    peer = _import_test_helper("mujoco_peer")
+    q, qd = (0.02, -0.03, 0.1), (0.05, 0.02, 0.1)  # as benchmarks/mujoco_peer.py
+    number, repeats = int(args["number"]), int(args["repeats"])
+    results: dict[str, Any] = {"version": mujoco.__version__, "actuations": {}}
+    with tempfile.TemporaryDirectory(prefix="rpr3bench-mujoco-") as tmp:
+        build = Path(tmp)
+        for actuation in args["actuations"]:
+            model = _control_model(actuation)
+            xml = peer.build_mjcf(model.params, actuation, integrator="RK4")
+            mj_model = mujoco.MjModel.from_xml_string(xml)
+            data = mujoco.MjData(mj_model)
+            peer.set_state(mj_model, data, q, qd)
+            # Efforts that hold the motion gently: the inverse dynamics at q'' = 0.
+            (out,), _ = rpr3gen.evaluate(model, "inverse_dynamics", ([q], [qd], [(0.0,) * 3]))
+            names = rpr3gen.manifest.load(actuation).function("inverse_dynamics").outputs[0].names
+            data.ctrl[:] = [
+                out[0, list(names).index(f"{EFFORT[actuation]}_{leg}")] for leg in "ABC"
+            ]
+            qpos, qvel, ctrl = data.qpos.copy(), data.qvel.copy(), data.ctrl.copy()
+            timings = {}
+            for name, call in (("mj_forward", mujoco.mj_forward), ("mj_step", mujoco.mj_step)):
+                data.qpos[:], data.qvel[:] = qpos, qvel
+                mujoco.mj_forward(mj_model, data)
+                times = [
+                    t / number
+                    for t in timeit.repeat(
+                        lambda c=call, m=mj_model, d=data: c(m, d), number=number, repeat=repeats
+                    )
+                ]
+                timings[name] = {"median": statistics.median(times), "best": min(times)}
+            (build / f"{actuation}.xml").write_text(xml)
+            state = build / f"{actuation}.state"
+            values = " ".join(repr(float(v)) for v in [*qpos, *qvel, *ctrl])
+            state.write_text(f"{mj_model.nq} {mj_model.nv} {mj_model.nu}\n{values}\n")
+            c_run = charness.run_mujoco(build, build / f"{actuation}.xml", state, number, repeats)
+            results["actuations"][actuation] = {
+                "python": timings,
+                "c": c_run,
+                "timestep": float(mj_model.opt.timestep),
+                "integrator": str(mujoco.mjtIntegrator(mj_model.opt.integrator).name),
+                "nq": int(mj_model.nq),
+            }
+    return results
+
+
 WORKERS: dict[str, Callable[[dict[str, Any]], dict[str, Any]]] = {
     "regen": worker_regen,
     "numpy": worker_numpy,
     "newton_euler": worker_newton_euler,
     "lambdify": worker_lambdify,
     "python_single": worker_python_single,
+    "control_python": worker_control_python,
+    "fk_iterations": worker_fk_iterations,
+    "mujoco": worker_mujoco,
 }
 
 
