@@ -521,6 +521,26 @@ def test_task_space_dynamics_balances_newton_euler_efforts(
 
 
 @pytest.mark.parametrize("motion", NE_MOTIONS)
+@pytest.mark.parametrize(("actuation", "backend"), _cases())
+def test_actuator_efforts_are_the_newton_euler_efforts(
+    actuation: str, backend: str, motion: str | int
+) -> None:
+    """The generated ``actuator_efforts`` (the computed-torque law's efforts) against the
+    independent solver, and against ``J^-T (M q'' + c)`` of the task-space dynamics."""
+    *models, q, qd, qdd = _newton_euler_motion(motion)
+    model = models[ACTUATIONS.index(actuation)]
+    tau = rpr3gen.actuator_efforts(model, q, qd, qdd, backend)
+    assert (
+        _relative(tau, _legs(ne.solve(model.params, actuation, q, qd, qdd), EFFORT[actuation]))
+        < 1e-9
+    )
+    M, c = rpr3gen.task_space_dynamics(model, q, qd, backend)
+    J = rpr3gen.actuator_jacobian(model, q, backend)
+    law = np.linalg.solve(np.swapaxes(J, 1, 2), (np.einsum("nij,nj->ni", M, qdd) + c)[..., None])
+    assert _relative(tau, law[..., 0]) < 1e-9
+
+
+@pytest.mark.parametrize("motion", NE_MOTIONS)
 @pytest.mark.parametrize("backend", BACKENDS)
 def test_mechanism_dynamics_do_not_depend_on_the_actuation(backend: str, motion: str | int) -> None:
     """M and c belong to the mechanism: the same for both actuations (only J and tau differ)."""
@@ -643,6 +663,8 @@ def _evaluate(function: str, motion: Motion, backend: str) -> list[np.ndarray]:
         return list(rpr3gen.task_space_dynamics(model, q, qd, backend))
     if function == "forward_dynamics":
         return [rpr3gen.forward_dynamics(model, q, qd, 10 * qdd, backend)]
+    if function == "actuator_efforts":
+        return [rpr3gen.actuator_efforts(model, q, qd, qdd, backend)]
     assert function == "assembly_modes"
     qa = rpr3gen.actuator_coordinates(model, q[:10])
     return [rpr3gen.assembly_modes(model, row, backend) for row in qa]
@@ -655,6 +677,7 @@ FUNCTIONS = (
     "platform_velocity",
     "task_space_dynamics",
     "forward_dynamics",
+    "actuator_efforts",
     "assembly_modes",
 )
 

@@ -43,6 +43,7 @@ STEP_TANGENT = "loads differentiated with respect to the platform acceleration, 
 STEP_BIAS = "loads at zero platform acceleration, eqs. (10)-(17)"
 STEP_TASK = "task-space dynamics, M q'' + c = J^T tau"
 STEP_FORWARD = "forward dynamics, LDL^T solve of M q'' = J^T tau - c"
+STEP_VELOCITY = "platform velocity from the actuator rates, J q' = qa'"
 STEP_FK_REVOLUTE = "direct kinematics, revolute actuation (closed form)"
 STEP_FK_PRISMATIC = "direct kinematics, prismatic actuation (sextic in tan(phi/2))"
 
@@ -82,8 +83,10 @@ DEGENERACY_TOL = 1e-10
 UPPER: tuple[tuple[int, int], ...] = ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))
 
 
-_RESERVED = frozenset(PARAM_NAMES) | frozenset(
-    s.name for s in (*syms.q, *syms.qd, *syms.qdd, *qa, *tau)
+_RESERVED = (
+    frozenset(PARAM_NAMES)
+    | frozenset(s.name for s in (*syms.q, *syms.qd, *syms.qdd, *qa, *tau))
+    | frozenset(f"qa_dot_{leg}" for leg in LEGS)
 )
 
 
@@ -520,6 +523,37 @@ def ldlt_solve(prog: Program, M: sp.Matrix, rhs: sp.Matrix, name: str, step: str
     x2 = bld.define(f"{name}_x2", z2 * inv_d2 - l32 * x3, step)
     x1 = bld.define(f"{name}_x1", z1 * inv_d1 - l21 * x2 - l31 * x3, step)
     return sp.Matrix([x1, x2, x3])
+
+
+def cofactor_solve(prog: Program, A: sp.Matrix, rhs: sp.Matrix, name: str, step: str) -> sp.Matrix:
+    """Solve ``A x = rhs`` for a general 3 x 3 ``A`` by cofactors: ``x = adj(A) rhs / det A``.
+
+    The entries of ``A`` are named first (``{name}_A11`` ...), so the adjugate multiplies names,
+    and ``1 / det A`` is one division.
+    """
+    bld = _Builder(prog)
+    a = sp.Matrix(3, 3, lambda i, j: bld.define(f"{name}_A{i + 1}{j + 1}", A[i, j], step))
+    adj = a.adjugate()
+    det = bld.define(f"{name}_det", sum(a[0, j] * adj[j, 0] for j in range(3)), step)
+    inv_det = bld.define(f"{name}_inv_det", 1 / det, step)
+    return sp.Matrix(
+        [
+            bld.define(
+                f"{name}_x{i + 1}", sum(adj[i, j] * rhs[j] for j in range(3)) * inv_det, step
+            )
+            for i in range(3)
+        ]
+    )
+
+
+#: The actuator rates ``qa'``, inputs of :func:`platform_velocity`.
+qa_dot = sp.Matrix([sp.Symbol(f"qa_dot_{leg}", real=True) for leg in LEGS])
+
+
+def platform_velocity(prog: Program, actuation: str) -> sp.Matrix:
+    """``q' = J^-1 qa'`` (3-vector): the platform velocity that the actuator rates produce."""
+    J = actuator_jacobian(prog, actuation)
+    return cofactor_solve(prog, J, qa_dot, "pv", STEP_VELOCITY)
 
 
 def forward_dynamics(prog: Program, actuation: str) -> sp.Matrix:

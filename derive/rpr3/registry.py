@@ -305,6 +305,62 @@ def jacobian_rate(actuation: str) -> FunctionSpec:
     )
 
 
+def platform_velocity(actuation: str) -> FunctionSpec:
+    """``rpr3_platform_velocity``: ``q' = J^-1 qa'``, the velocity map backwards."""
+    prog = Program()
+    qd = control.platform_velocity(prog, actuation)
+    qa = actuator_argument(actuation)
+    rates = Argument(
+        "qa_dot",
+        tuple(control.qa_dot),
+        tuple(Component(f"d{c.name}", f"{c.unit}/s", f"rate of {c.name}") for c in qa.components),
+        "actuator rates",
+    )
+    return FunctionSpec(
+        name="platform_velocity",
+        doc="Platform velocity q' = J^-1 qa' from the actuator rates (a generated 3 x 3 solve by "
+        "cofactors): the velocity a controller reconstructs from its encoders.",
+        inputs=(POSE, rates),
+        outputs=(
+            _triple(
+                "qd",
+                qd,
+                tuple(c.name for c in VELOCITY.components),
+                tuple(c.unit for c in VELOCITY.components),
+                "platform velocity",
+            ),
+        ),
+        program=prog,
+        checks=_pose_checks(prog, actuation),
+    )
+
+
+def actuator_efforts(actuation: str) -> FunctionSpec:
+    """``rpr3_actuator_efforts``: the actuator efforts alone of the inverse dynamics."""
+    prog = Program()
+    outputs = control.include_inverse_dynamics(prog, actuation).outputs
+    tau = effort_argument(actuation)
+    family = control.ACTUATORS[actuation].effort
+    return FunctionSpec(
+        name="actuator_efforts",
+        doc=f"Actuator efforts ({family}_A, _B, _C) that produce the platform acceleration qdd at "
+        "(q, qd): the inverse dynamics' actuator loads (eqs. 12-17) alone, which is also "
+        "tau = J^-T (M qdd + c), the computed-torque law's efforts for a commanded qdd.",
+        inputs=(POSE, VELOCITY, ACCELERATION),
+        outputs=(
+            _triple(
+                "tau",
+                sp.Matrix([outputs[f"{family}_{leg}"] for leg in LEGS]),
+                tuple(c.name for c in tau.components),
+                tuple(c.unit for c in tau.components),
+                "actuator efforts",
+            ),
+        ),
+        program=prog,
+        checks=_pose_checks(prog, actuation),
+    )
+
+
 def task_space_dynamics(actuation: str) -> FunctionSpec:
     """``rpr3_task_space_dynamics``: ``M`` (row-major) and ``c`` with ``M q'' + c = J^T tau``."""
     prog = Program()
@@ -573,6 +629,8 @@ FUNCTIONS: Mapping[str, FunctionBuilder] = {
     "actuator_coordinates": actuator_coordinates,
     "actuator_jacobian": actuator_jacobian,
     "jacobian_rate": jacobian_rate,
+    "platform_velocity": platform_velocity,
+    "actuator_efforts": actuator_efforts,
     "task_space_dynamics": task_space_dynamics,
     "forward_dynamics": forward_dynamics,
     "assembly_modes": assembly_modes,

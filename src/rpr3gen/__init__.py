@@ -17,6 +17,7 @@ import importlib.metadata
 from rpr3gen.backends import BACKENDS, OUTPUT_NAMES, evaluate, inverse_dynamics
 from rpr3gen.control import (
     actuator_coordinates,
+    actuator_efforts,
     actuator_jacobian,
     assembly_modes,
     forward_dynamics,
@@ -60,6 +61,7 @@ __all__ = [
     "TrajectoryWarning",
     "__version__",
     "actuator_coordinates",
+    "actuator_efforts",
     "actuator_jacobian",
     "assembly_modes",
     "evaluate",

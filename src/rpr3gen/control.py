@@ -32,6 +32,7 @@ from rpr3gen.model import LEGS, Model
 
 __all__ = [
     "actuator_coordinates",
+    "actuator_efforts",
     "actuator_jacobian",
     "assembly_modes",
     "forward_dynamics",
@@ -77,11 +78,20 @@ def jacobian_rate(model: Model, q: ArrayLike, qd: ArrayLike, backend: str = "num
 def platform_velocity(
     model: Model, q: ArrayLike, qa_dot: ArrayLike, backend: str = "numpy"
 ) -> np.ndarray:
-    """``q' = J^-1 qa'``, (n, 3): the platform velocity from the actuator rates."""
-    J = actuator_jacobian(model, q, backend)
-    rates = samples("qa_dot", qa_dot, 3)
-    with np.errstate(invalid="ignore"):
-        return np.linalg.solve(J, rates[..., np.newaxis])[..., 0]
+    """``q' = J^-1 qa'``, (n, 3): the platform velocity from the actuator rates (a generated
+    3 x 3 solve)."""
+    (qd,), _ = evaluate(model, "platform_velocity", (q, qa_dot), backend)
+    return qd
+
+
+def actuator_efforts(
+    model: Model, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, backend: str = "numpy"
+) -> np.ndarray:
+    """The actuator efforts (n, 3) for the platform motion (q, q', q''): the inverse dynamics'
+    actuator loads alone, which is ``tau = J^-T (M q'' + c)``, the task-space computed-torque
+    law's efforts for a commanded acceleration ``q''``."""
+    (tau,), _ = evaluate(model, "actuator_efforts", (q, qd, qdd), backend)
+    return tau
 
 
 def task_space_dynamics(
