@@ -91,9 +91,13 @@ class Controller:
     """Encoder counts in, actuator efforts out; the nominal model's generated C functions."""
 
     def __init__(self, model: rpr3gen.Model, resolution: float, amplitude: np.ndarray):
+        # Each a generated C function behind preallocated buffers; the velocity map and the
+        # computed-torque law are generated too, so the tick does no 3 x 3 algebra in Python:
+        # platform_velocity solves J qd = qa'; actuator_efforts at the commanded acceleration a
+        # is tau = J^-T (M a + c) (the C program writes that law out with task_space_dynamics).
         self.fk = rpr3gen.SampleEvaluator(model, function="forward_kinematics")
-        self.jacobian = rpr3gen.SampleEvaluator(model, function="actuator_jacobian")
-        self.dynamics = rpr3gen.SampleEvaluator(model, function="task_space_dynamics")
+        self.velocity = rpr3gen.SampleEvaluator(model, function="platform_velocity")
+        self.efforts = rpr3gen.SampleEvaluator(model, function="actuator_efforts")
         self.resolution, self.amplitude = resolution, amplitude
         self.alpha = 1.0 - math.exp(-2.0 * math.pi * RATE_CUTOFF_HZ / RATE_HZ)
         self.q1 = np.zeros(3)  # the last two pose estimates; the robot was parked at home
@@ -127,32 +131,26 @@ class Controller:
             fk.q[:] = fk.q_near  # coast on the prediction
         q = fk.q.copy()
         self.q2, self.q1 = (q if first else self.q1), q  # at first, at rest
-        # the velocity: J qd = qa'
-        self.jacobian.q[:] = q
-        J = self.jacobian.J.reshape(3, 3)
-        try:
-            if self.jacobian():
-                raise np.linalg.LinAlgError
-            self.qd = np.linalg.solve(J, self.rate)
-        except np.linalg.LinAlgError:
+        # the velocity: J qd = qa' (the "jacobian" count is this solve's failures)
+        vel = self.velocity
+        vel.q[:], vel.qa_dot[:] = q, self.rate
+        if vel():
             self.failed["jacobian"] += 1
             self.latency["dynamics"] = 0
             return self.tau  # hold the last efforts
-        # computed torque in task space: J^T tau = M (qdd_d + Kd e' + Kp e) + c
+        self.qd = vel.qd.copy()
+        # computed torque in task space: tau = J^-T (M (qdd_d + Kd e' + Kp e) + c)
         q_d, qd_d, qdd_d = reference(self.amplitude, t)
-        acc = qdd_d + KD * (qd_d - self.qd) + KP * (q_d - q)
-        dyn = self.dynamics
-        dyn.q[:], dyn.qd[:] = q, self.qd
+        eff = self.efforts
+        eff.q[:], eff.qd[:] = q, self.qd
+        eff.qdd[:] = qdd_d + KD * (qd_d - self.qd) + KP * (q_d - q)
         start = clock()
-        status = dyn()
-        if status == 0:
-            try:
-                self.tau = np.linalg.solve(J.T, dyn.M.reshape(3, 3) @ acc + dyn.c)
-            except np.linalg.LinAlgError:
-                status = -1
+        status = eff()
         self.latency["dynamics"] = clock() - start
         if status:
             self.failed["dynamics"] += 1
+        else:
+            self.tau = eff.tau.copy()
         return self.tau
 
 
