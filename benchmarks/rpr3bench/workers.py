@@ -490,6 +490,8 @@ def _python_ticks(model: Any, data: dict[str, Any]) -> dict[str, Callable[[], An
     """Python control ticks over the trajectories, each a function that runs one pass (every
     sample, tracking FK from each trajectory's start) and returns the efforts (n, 3).
 
+    - ``generated``: generated calls only: FK, ``platform_velocity`` (J q' = qa') and
+      ``actuator_efforts`` at the commanded acceleration (tau = J^-T (M a + c), the law in C);
     - ``numpy``: the generated calls (``SampleEvaluator``, c backend) and ``numpy.linalg.solve``
       for the velocity and the torque solves;
     - ``floats``: the same calls, the 3x3 algebra on Python floats (J^-1 by cofactors, once);
@@ -501,6 +503,8 @@ def _python_ticks(model: Any, data: dict[str, Any]) -> dict[str, Callable[[], An
     import rpr3gen
 
     fk = rpr3gen.SampleEvaluator(model, backend="c", function="forward_kinematics")
+    vel = rpr3gen.SampleEvaluator(model, backend="c", function="platform_velocity")
+    eff = rpr3gen.SampleEvaluator(model, backend="c", function="actuator_efforts")
     jac = rpr3gen.SampleEvaluator(model, backend="c", function="actuator_jacobian")
     tsd = rpr3gen.SampleEvaluator(model, backend="c", function="task_space_dynamics")
     idy = rpr3gen.SampleEvaluator(model, backend="c", function="inverse_dynamics")
@@ -510,6 +514,29 @@ def _python_ticks(model: Any, data: dict[str, Any]) -> dict[str, Callable[[], An
     starts = set(data["starts"])
     rows = {k: data[k] for k in ("q", "qd", "qdd", "qa", "qa_dot")}
     lists = {k: v.tolist() for k, v in rows.items()}
+
+    def generated_tick() -> Any:
+        q_des, qd_des, qdd_des, qa, qa_dot = (rows[k] for k in ("q", "qd", "qdd", "qa", "qa_dot"))
+        taus = np.empty((n, 3))
+        q1 = q2 = q_des[0]
+        for k in range(n):
+            if k in starts:
+                q1 = q2 = q_des[k]
+            fk.qa[:] = qa[k]
+            fk.q_near[:] = 2.0 * q1 - q2
+            if fk():
+                raise RuntimeError(f"forward kinematics failed at sample {k}")
+            q = fk.q.copy()
+            vel.q[:] = q
+            vel.qa_dot[:] = qa_dot[k]
+            vel()
+            eff.q[:] = q
+            eff.qd[:] = vel.qd
+            eff.qdd[:] = qdd_des[k] + KD * (qd_des[k] - vel.qd) + KP * (q_des[k] - q)
+            eff()
+            taus[k] = eff.tau
+            q1, q2 = q, q1
+        return taus
 
     def numpy_tick() -> Any:
         q_des, qd_des, qdd_des, qa, qa_dot = (rows[k] for k in ("q", "qd", "qdd", "qa", "qa_dot"))
@@ -602,7 +629,12 @@ def _python_ticks(model: Any, data: dict[str, Any]) -> dict[str, Callable[[], An
             q1, q2 = q, q1
         return taus
 
-    return {"numpy": numpy_tick, "floats": floats_tick, "inverse_dynamics": id_tick}
+    return {
+        "generated": generated_tick,
+        "numpy": numpy_tick,
+        "floats": floats_tick,
+        "inverse_dynamics": id_tick,
+    }
 
 
 def worker_control_python(args: dict[str, Any]) -> dict[str, Any]:
