@@ -24,7 +24,7 @@ differentiates the efforts with respect to the parameters, assignment by assignm
 efforts that hold the payload wrench at rest, which depend on the pose only.
 
 :func:`base_parameters` is Gautier's numerical method on a stacked regressor (QR of the
-observation matrix); :data:`REGROUPINGS` and :func:`regrouping_matrix` state the regroupings
+observation matrix); :func:`regroupings` and :func:`regrouping_matrix` state the regroupings
 found with it in closed form (docs/identification.md).
 """
 
@@ -44,6 +44,7 @@ from rpr3gen_derive.rpr3.derivation import ACTUATIONS
 from rpr3gen_derive.rpr3.dynamics import (
     STEP_INERTIA,
     STEP_RECURSION,
+    BodyMotion,
     LegWrenches,
     body_motions,
     required_wrench,
@@ -102,7 +103,12 @@ def _linear(vector: sp.Matrix) -> sp.Matrix:
 
 
 def body_wrench(
-    motion, mass: sp.Expr, first_moment: sp.Matrix, inertia_zz: sp.Expr, axis: int, gravity
+    motion: BodyMotion,
+    mass: sp.Expr,
+    first_moment: sp.Matrix,
+    inertia_zz: sp.Expr,
+    axis: int,
+    gravity: sp.Matrix,
 ) -> tuple[sp.Matrix, sp.Matrix]:
     """``F_k0``, ``M_k0`` of ``dynamics.required_wrench`` (eqs. 10-11, no external load) as
     linear forms in ``(m, m c, J)``, all about the joint point and in the body frame.
@@ -375,11 +381,7 @@ def base_parameters(
     regrouped = tuple(
         names[j] for j in dependent if names[j] not in unidentifiable and np.any(matrix[:, j])
     )
-    alone = tuple(
-        names[j]
-        for k, j in enumerate(base)
-        if np.count_nonzero(matrix[k]) == 1 and not np.any(matrix[:, j][np.arange(len(base)) != k])
-    )
+    alone = tuple(names[j] for k, j in enumerate(base) if np.count_nonzero(matrix[k]) == 1)
     return BaseParameters(
         names=tuple(names[j] for j in base),
         matrix=matrix,
@@ -393,7 +395,7 @@ def base_parameters(
 def preference(identical_legs: bool = False) -> tuple[str, ...]:
     """The order in which base columns are chosen: the platform's parameters first, then per
     leg the cylinder's first moments and inertia, the piston's first moments, its inertia and
-    mass, and the cylinder's mass last. This keeps the regroupings of :data:`REGROUPINGS`:
+    mass, and the cylinder's mass last. This keeps the regroupings of :func:`regroupings`:
     the piston's mass and inertia are the parameters eliminated."""
     legs = ("",) if identical_legs else LEGS
     order = ["m_3", "mcx_3", "mcy_3", "Jzz_3"]
