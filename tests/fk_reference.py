@@ -34,7 +34,7 @@ MAX_MODES: dict[str, int] = {"revolute": 2, "prismatic": 6}
 #: A leg shorter than this times the platform's RMS radius has no length (not a mode).
 LENGTH_TOL = 1e-9
 #: Revolute direct kinematics: all legs parallel (``|k|``) or ``|(A, B)| / (|k| rho)`` below this
-#: is degenerate (no isolated mode); see ``control.assembly_modes_revolute``.
+#: is degenerate (no isolated mode); see ``direct_kinematics.assembly_modes_revolute``.
 DEGENERACY_TOL = 1e-10
 #: Sampled sextic: an extremum within this fraction of the polynomial's scale of zero is a root.
 TOUCH_TOL = 1e-9
@@ -228,8 +228,9 @@ def leg_lengths_along_axis(geom: Geometry, qa: Sequence[float], q: Sequence[floa
 def revolute_modes(geom: Geometry, qa: Sequence[float]) -> list[Pose]:
     """Every assembly mode of revolute actuation (0, 1 or 2), closed form.
 
-    ``A cos(phi) + B sin(phi) + C = 0`` (see ``control.assembly_modes_revolute``), then ``G`` from
-    the normal equations of the three line conditions. A mode needs ``A^2 + B^2 >= C^2``,
+    ``A cos(phi) + B sin(phi) + C = 0`` (see ``direct_kinematics.assembly_modes_revolute``),
+    then ``G`` from the normal equations of the three line conditions. A mode needs
+    ``A^2 + B^2 >= C^2``,
     ``|(A, B)| > DEGENERACY_TOL |k| rho``, ``|k| > DEGENERACY_TOL`` and every leg length
     ``(A3 - A1) . e_i`` above ``LENGTH_TOL * rho`` (round-off of a zero length is not a mode).
     Sorted by phi, phi in ``(-pi, pi]``; two coincident modes (a singularity) are reported once.
@@ -327,7 +328,7 @@ def _mul(a: Sequence[float], b: Sequence[float]) -> list[float]:
 
 def sextic_coefficients(geom: Geometry, qa: Sequence[float]) -> list[float]:
     """``a0..a6`` (ascending) of the sextic in ``t = tan(phi/2)``, as
-    ``control.sextic_coefficients`` (m^6)."""
+    ``direct_kinematics.sextic_coefficients`` (m^6)."""
     h = _harmonics(geom, qa)
     rb, rc = _half(h["rho"][0]), _half(h["rho"][1])
     wbb, wcc = _half(h["wsq"][0]), _half(h["wsq"][1])
@@ -343,7 +344,7 @@ def sextic_coefficients(geom: Geometry, qa: Sequence[float]) -> list[float]:
 def pose_candidates(geom: Geometry, qa: Sequence[float], phi: float) -> list[Pose]:
     """Poses with orientation ``phi`` that close legs B, C relative to leg A (back substitution).
 
-    ``u = (rho_C w_B^perp - rho_B w_C^perp) / D`` (``control.pose_from_angle``). Where
+    ``u = (rho_C w_B^perp - rho_B w_C^perp) / D`` (``direct_kinematics.pose_from_angle``). Where
     ``|D| <= 1e-9 |w_B| |w_C|`` the two linear equations for ``u`` are (nearly) parallel: then
     the line ``u . w = rho`` of the longer ``w`` is intersected with the circle ``|u| = L_A``
     (0, 1 or 2 candidates); when both ``w`` vanish (``<= 1e-12 rho``) there is no isolated pose.

@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 import sympy as sp
 from rpr3gen_derive.codegen.program import Program
-from rpr3gen_derive.rpr3 import control, registry
+from rpr3gen_derive.rpr3 import control, direct_kinematics, registry
 from rpr3gen_derive.rpr3 import symbols as syms
 from rpr3gen_derive.rpr3.derivation import derive
 from rpr3gen_derive.rpr3.symbols import PARAM_NAMES
@@ -60,12 +60,12 @@ def _build(actuation: str) -> Model:
     inputs = [*PARAMS, *syms.q, *syms.qd, *control.tau]
     dynamics = compile_program(prog, inputs, outputs)
     if actuation == "revolute":
-        modes = control.assembly_modes_revolute(prog)
+        modes = direct_kinematics.assembly_modes_revolute(prog)
         fk_out = [getattr(m, name) for m in modes for name in ("x", "y", "phi", "margin")]
         fk_fn = compile_program(prog, [*PARAMS, *control.qa], fk_out)
     else:
-        coefficients = control.sextic_coefficients(prog)
-        x, y = control.pose_from_angle(prog, COS_IN, SIN_IN)
+        coefficients = direct_kinematics.sextic_coefficients(prog)
+        x, y = direct_kinematics.pose_from_angle(prog, COS_IN, SIN_IN)
         fk_fn = compile_program(prog, [*PARAMS, *control.qa, COS_IN, SIN_IN], [*coefficients, x, y])
     return Model(actuation, prog, dynamics, fk_fn)
 

@@ -24,7 +24,7 @@ from rpr3gen_derive.codegen.spec import (
     ReturnCode,
     Threshold,
 )
-from rpr3gen_derive.rpr3 import control
+from rpr3gen_derive.rpr3 import control, direct_kinematics
 from rpr3gen_derive.rpr3 import symbols as syms
 from rpr3gen_derive.rpr3.derivation import (
     ACTUATIONS,
@@ -419,7 +419,7 @@ def assembly_modes(actuation: str) -> FunctionSpec:
     qa = actuator_argument(actuation)
     checks = (Check("inputs_not_finite", "NOT_FINITE"),)
     if actuation == "revolute":
-        modes = control.assembly_modes_revolute(prog)
+        modes = direct_kinematics.assembly_modes_revolute(prog)
         return FunctionSpec(
             name="assembly_modes",
             doc="Both assembly modes of the actuator angles qa, in closed form: the closure "
@@ -446,7 +446,7 @@ def assembly_modes(actuation: str) -> FunctionSpec:
             program=prog,
             checks=checks,
         )
-    coefficients = control.sextic_coefficients(prog)
+    coefficients = direct_kinematics.sextic_coefficients(prog)
     return FunctionSpec(
         name="assembly_modes",
         doc="The direct kinematics of the piston displacements qa as a polynomial: coefficients "
@@ -479,7 +479,7 @@ def pose_from_angle(actuation: str) -> FunctionSpec | None:
     if actuation != "prismatic":
         return None
     prog = Program()
-    x, y = control.pose_from_angle(prog, *ANGLE.symbols)
+    x, y = direct_kinematics.pose_from_angle(prog, *ANGLE.symbols)
     return FunctionSpec(
         name="pose_from_angle",
         doc="Position of G for a platform angle phi that solves the direct kinematics of the "
@@ -611,8 +611,8 @@ def forward_kinematics(actuation: str) -> FunctionSpec:
         c_body="forward_kinematics.c.jinja",
         c_context=(
             ("actuation", actuation),
-            ("max_modes", control.MAX_MODES[actuation]),
-            ("length_tol", repr(control.LENGTH_TOL)),
+            ("max_modes", direct_kinematics.MAX_MODES[actuation]),
+            ("length_tol", repr(direct_kinematics.LENGTH_TOL)),
             ("param_names", PARAM_NAMES),
             *FK_TUNING,
             ("trace", False),
@@ -672,6 +672,10 @@ def module(actuation: str, functions: Mapping[str, FunctionBuilder] | None = Non
         thresholds=THRESHOLDS,
         defines=(
             ("ACTUATION", f'"{actuation}"', ""),
-            ("MAX_MODES", str(control.MAX_MODES[actuation]), "most assembly modes of one qa"),
+            (
+                "MAX_MODES",
+                str(direct_kinematics.MAX_MODES[actuation]),
+                "most assembly modes of one qa",
+            ),
         ),
     )
