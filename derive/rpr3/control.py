@@ -275,7 +275,7 @@ def at_zero(
     return [sp.sympify(e).xreplace(replace) for e in exprs]
 
 
-def _depends_on(prog: Program, expr: sp.Expr, variables: Sequence[sp.Symbol]) -> bool:
+def depends_on(prog: Program, expr: sp.Expr, variables: Sequence[sp.Symbol]) -> bool:
     """True when ``expr`` depends on ``variables``, directly or through assignments."""
     definitions = prog.definitions()
     targets = set(variables)
@@ -344,7 +344,7 @@ def _effort_affine(prog: Program, actuation: str) -> tuple[sp.Matrix, sp.Matrix]
     efforts = [derivation.outputs[f"{ACTUATORS[actuation].effort}_{leg}"] for leg in LEGS]
     A = sp.Matrix(differentiate(prog, efforts, list(syms.qdd), STEP_TANGENT))
     for entry in A:
-        if _depends_on(prog, entry, list(syms.qdd)):
+        if depends_on(prog, entry, list(syms.qdd)):
             raise RuntimeError("the actuator loads are not affine in the platform acceleration")
     b = sp.Matrix(at_zero(prog, efforts, list(syms.qdd), "_qdd0", STEP_BIAS))
     return A, b
@@ -472,7 +472,7 @@ def task_space_dynamics(
             for i, j in UPPER:
                 mass[i, j] += row[i] * column[j]
         for entry in mass:
-            if _depends_on(prog, entry, list(syms.qdd)):
+            if depends_on(prog, entry, list(syms.qdd)):
                 raise RuntimeError("the generalized forces are not affine in q''")
         at_rest = at_zero(prog, powers, list(syms.qdd), "_qdd0", STEP_BIAS)
         bias = sp.zeros(3, 1)

@@ -7,12 +7,18 @@ parameters (docs/conventions.md, docs/interfaces.md) are here too.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import sympy as sp
 from rpr3gen_derive.codegen.program import Program
-from rpr3gen_derive.rpr3.dynamics import leg_wrenches
-from rpr3gen_derive.rpr3.kinematics import leg_kinematics, platform_rotation, reach
+from rpr3gen_derive.rpr3.dynamics import LegWrenches, leg_wrenches
+from rpr3gen_derive.rpr3.kinematics import (
+    LegKinematics,
+    leg_kinematics,
+    platform_rotation,
+    reach,
+)
 from rpr3gen_derive.rpr3.symbols import LEGS, PARAM_NAMES
 from rpr3gen_derive.rpr3.virtual_work import joint_loads
 
@@ -105,17 +111,27 @@ OUTPUT_DOCS: tuple[tuple[str, str, str], ...] = tuple(
 ) + tuple((f.name, f.unit, f.meaning) for f in SAMPLE_OUTPUTS)
 
 
-def derive(actuation: str) -> tuple[Program, dict[str, sp.Expr]]:
-    """Run the paper's algorithm (steps 1-9) symbolically; return the program and outputs."""
+WrenchBuilder = Callable[[Program, LegKinematics, bool], LegWrenches]
+
+
+def algorithm(
+    prog: Program, actuation: str, wrench_builder: WrenchBuilder = leg_wrenches
+) -> tuple[dict[str, LegKinematics], dict[str, sp.Expr]]:
+    """The paper's algorithm on ``prog``: the leg kinematics (eqs. 5, 6, 9), each leg's wrenches
+    (eqs. 10-11, by ``wrench_builder(prog, kinematics, carries_platform)``) and every joint load
+    by virtual work (eqs. 7-8, 12-17). Returns the kinematics and the loads."""
     if actuation not in ACTUATIONS:
         raise ValueError(f"actuation must be one of {ACTUATIONS}, got {actuation!r}")
-    prog = Program()
     cos_phi, sin_phi = platform_rotation(prog)
     kinematics = {leg: leg_kinematics(prog, leg, cos_phi, sin_phi) for leg in LEGS}
-    wrenches = {
-        leg: leg_wrenches(prog, kinematics[leg], carries_platform=(leg == LEGS[0])) for leg in LEGS
-    }
-    loads = joint_loads(prog, actuation, kinematics, wrenches)
+    wrenches = {leg: wrench_builder(prog, kinematics[leg], leg == LEGS[0]) for leg in LEGS}
+    return kinematics, joint_loads(prog, actuation, kinematics, wrenches)
+
+
+def derive(actuation: str) -> tuple[Program, dict[str, sp.Expr]]:
+    """Run the paper's algorithm (steps 1-9) symbolically; return the program and outputs."""
+    prog = Program()
+    kinematics, loads = algorithm(prog, actuation)
     values: dict[str, sp.Expr] = {}
     for leg, kin in kinematics.items():
         for name in ("phi10", "lambda21", "phi32", "omega10", "v21", "omega32"):

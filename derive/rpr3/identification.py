@@ -39,8 +39,8 @@ import scipy.linalg
 import sympy as sp
 from rpr3gen_derive.codegen.program import Program
 from rpr3gen_derive.rpr3 import symbols as syms
-from rpr3gen_derive.rpr3.control import ACTUATORS, at_zero, differentiate
-from rpr3gen_derive.rpr3.derivation import ACTUATIONS
+from rpr3gen_derive.rpr3.control import ACTUATORS, at_zero, depends_on, differentiate
+from rpr3gen_derive.rpr3.derivation import algorithm
 from rpr3gen_derive.rpr3.dynamics import (
     STEP_INERTIA,
     STEP_RECURSION,
@@ -50,9 +50,8 @@ from rpr3gen_derive.rpr3.dynamics import (
     required_wrench,
 )
 from rpr3gen_derive.rpr3.frames import skew, u1, u3
-from rpr3gen_derive.rpr3.kinematics import LegKinematics, leg_kinematics, platform_rotation
+from rpr3gen_derive.rpr3.kinematics import LegKinematics
 from rpr3gen_derive.rpr3.symbols import LEGS
-from rpr3gen_derive.rpr3.virtual_work import joint_loads
 
 STEP_REGRESSOR = "regressor: efforts differentiated by the inertial parameters, eqs. (10)-(17)"
 STEP_PAYLOAD = "efforts holding the payload at rest (inertial parameters zero), eqs. (12)-(17)"
@@ -184,16 +183,10 @@ def identification_wrenches(
 @cache
 def _efforts_program(actuation: str) -> tuple[Program, tuple[sp.Expr, ...]]:
     """The paper's algorithm (eqs. 5-17) with symbolic inertial parameters: the efforts."""
-    if actuation not in ACTUATIONS:
-        raise ValueError(f"actuation must be one of {ACTUATIONS}, got {actuation!r}")
     prog = Program()
-    cos_phi, sin_phi = platform_rotation(prog)
-    kinematics = {leg: leg_kinematics(prog, leg, cos_phi, sin_phi) for leg in LEGS}
-    wrenches = {
-        leg: identification_wrenches(prog, kinematics[leg], carries_platform=(leg == LEGS[0]))[0]
-        for leg in LEGS
-    }
-    loads = joint_loads(prog, actuation, kinematics, wrenches)
+    _, loads = algorithm(
+        prog, actuation, lambda p, kin, platform: identification_wrenches(p, kin, platform)[0]
+    )
     effort = ACTUATORS[actuation].effort
     return prog, tuple(loads[f"{effort}_{leg}"] for leg in LEGS)
 
@@ -244,9 +237,8 @@ def regressor(prog: Program, actuation: str) -> sp.Matrix:
     symbols = [pi_symbols[n] for n in INERTIAL_PARAMETER_NAMES]
     table = differentiate(prog, taus, symbols, STEP_REGRESSOR)
     Y = sp.Matrix(table)
-    definitions = prog.definitions()
     for entry in Y:
-        if _depends(definitions, entry, set(symbols)):
+        if depends_on(prog, entry, symbols):
             raise RuntimeError("the actuator efforts are not linear in the inertial parameters")
     return Y
 
@@ -257,20 +249,6 @@ def payload_efforts(prog: Program, actuation: str) -> sp.Matrix:
     taus = efforts(prog, actuation)
     symbols = [pi_symbols[n] for n in INERTIAL_PARAMETER_NAMES]
     return sp.Matrix(at_zero(prog, taus, symbols, "_pi0", STEP_PAYLOAD))
-
-
-def _depends(definitions: Mapping[sp.Symbol, sp.Expr], expr: sp.Expr, targets: set) -> bool:
-    seen: set[sp.Symbol] = set()
-    stack = list(sp.sympify(expr).free_symbols)
-    while stack:
-        s = stack.pop()
-        if s in targets:
-            return True
-        if s in seen or s not in definitions:
-            continue
-        seen.add(s)
-        stack.extend(definitions[s].free_symbols)
-    return False
 
 
 # ----------------------------------------------------------------------------------------------
