@@ -598,3 +598,22 @@ def tracked_forward_kinematics(
     if best is None:
         return Tracked((math.nan, math.nan, math.nan), "none", result.iterations)
     return Tracked(best, "fallback", result.iterations)
+
+
+# ----------------------------------------------------------------------------------------------
+# Samples shared by the forward-kinematics tests.
+
+
+def random_poses(rng: np.random.Generator, n: int) -> np.ndarray:
+    """``n`` poses near the central configuration: |x|, |y| <= 5 cm, |phi| <= 0.6 rad."""
+    return np.stack(
+        [rng.uniform(-0.05, 0.05, n), rng.uniform(-0.05, 0.05, n), rng.uniform(-0.6, 0.6, n)],
+        axis=1,
+    )
+
+
+def robots(rng: np.random.Generator, n: int) -> list[dict]:
+    """The paper's robot, then ``n - 1`` random ones (``newton_euler.random_robot``)."""
+    import newton_euler as ne
+
+    return [ne.paper_params()] + [ne.random_robot(rng)["params"] for _ in range(n - 1)]

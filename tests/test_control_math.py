@@ -277,17 +277,6 @@ def test_free_motion_conserves_energy(model: Model) -> None:
 # Forward kinematics: revolute actuation
 
 
-def _random_poses(rng: np.random.Generator, n: int) -> np.ndarray:
-    return np.stack(
-        [rng.uniform(-0.05, 0.05, n), rng.uniform(-0.05, 0.05, n), rng.uniform(-0.6, 0.6, n)],
-        axis=1,
-    )
-
-
-def _robots(rng: np.random.Generator, n: int) -> list[dict]:
-    return [ne.paper_params()] + [ne.random_robot(rng)["params"] for _ in range(n - 1)]
-
-
 def _qa_inputs(params: dict, qa: np.ndarray) -> dict:
     values: dict = dict(params)
     for k, name in enumerate(control.QA_NAMES):
@@ -309,9 +298,9 @@ def test_revolute_modes_round_trip(models: dict[str, Model]) -> None:
     model = models["revolute"]
     rng = np.random.default_rng(11)
     counts = []
-    for params in _robots(rng, 12):
+    for params in fk.robots(rng, 12):
         geom = fk.Geometry.from_params(params)
-        poses = _random_poses(rng, 10)
+        poses = fk.random_poses(rng, 10)
         qa = _reference_qa(params, "revolute", poses)
         out = np.array(model.fk(**_qa_inputs(params, qa)))  # (8, n): x, y, phi, margin per mode
         for n, (pose, qa_n) in enumerate(zip(poses, qa, strict=True)):
@@ -361,9 +350,9 @@ def test_sextic_and_back_substitution_match_the_numeric_prototype(
 ) -> None:
     model = models["prismatic"]
     rng = np.random.default_rng(12)
-    for params in _robots(rng, 6):
+    for params in fk.robots(rng, 6):
         geom = fk.Geometry.from_params(params)
-        poses = _random_poses(rng, 8)
+        poses = fk.random_poses(rng, 8)
         qa = _reference_qa(params, "prismatic", poses)
         values = _qa_inputs(params, qa)
         values.update(cos_phi_in=np.cos(poses[:, 2]), sin_phi_in=np.sin(poses[:, 2]))
@@ -382,9 +371,9 @@ def test_prismatic_modes_round_trip(models: dict[str, Model]) -> None:
     model = models["prismatic"]
     rng = np.random.default_rng(13)
     counts = []
-    for params in _robots(rng, 12):
+    for params in fk.robots(rng, 12):
         geom = fk.Geometry.from_params(params)
-        for pose in _random_poses(rng, 8):
+        for pose in fk.random_poses(rng, 8):
             qa = _reference_qa(params, "prismatic", pose)[0]
             values = _qa_inputs(params, qa)
             values.update(cos_phi_in=1.0, sin_phi_in=0.0)
@@ -410,7 +399,7 @@ def test_six_real_modes_are_all_found() -> None:
     for _ in range(400):
         params = ne.random_robot(rng)["params"]
         geom = fk.Geometry.from_params(params)
-        pose = _random_poses(rng, 1)[0]
+        pose = fk.random_poses(rng, 1)[0]
         qa = _reference_qa(params, "prismatic", pose)[0]
         modes = fk.prismatic_modes(geom, qa)
         if len(modes) == 6:
@@ -532,9 +521,9 @@ def test_tracking_through_a_parallel_singularity() -> None:
 @pytest.mark.parametrize("actuation", ACTUATIONS)
 def test_tracking_converges_from_a_nearby_reference(actuation: str) -> None:
     rng = np.random.default_rng(21)
-    for params in _robots(rng, 6):
+    for params in fk.robots(rng, 6):
         geom = fk.Geometry.from_params(params)
-        for pose in _random_poses(rng, 5):
+        for pose in fk.random_poses(rng, 5):
             if not ne.well_conditioned(params, pose[None, :], max_cond=1e3):
                 continue
             qa = _reference_qa(params, actuation, pose)[0]
@@ -551,9 +540,9 @@ def test_tracking_falls_back_to_the_nearest_mode(actuation: str) -> None:
     reference, with phi next to the reference's (unwrapped)."""
     rng = np.random.default_rng(22)
     used = 0
-    for params in _robots(rng, 8):
+    for params in fk.robots(rng, 8):
         geom = fk.Geometry.from_params(params)
-        pose = _random_poses(rng, 1)[0]
+        pose = fk.random_poses(rng, 1)[0]
         qa = _reference_qa(params, actuation, pose)[0]
         near = (pose[0] + 0.08, pose[1] - 0.08, pose[2] + 2 * math.pi + 0.7)
         result = fk.tracked_forward_kinematics(geom, actuation, qa, near, max_iter=1)

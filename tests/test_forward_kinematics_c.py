@@ -42,17 +42,6 @@ def _qa(params: dict, actuation: str, q) -> np.ndarray:
     return np.stack([kin[leg][COORDINATE[actuation]] for leg in ne.LEGS], axis=1)
 
 
-def _poses(rng: np.random.Generator, n: int) -> np.ndarray:
-    return np.stack(
-        [rng.uniform(-0.05, 0.05, n), rng.uniform(-0.05, 0.05, n), rng.uniform(-0.6, 0.6, n)],
-        axis=1,
-    )
-
-
-def _robots(rng: np.random.Generator, n: int) -> list[dict]:
-    return [ne.paper_params()] + [ne.random_robot(rng)["params"] for _ in range(n - 1)]
-
-
 def _fk(model: Model, qa, near) -> tuple[np.ndarray, np.ndarray]:
     (q,), codes = rpr3gen.evaluate(model, "forward_kinematics", (qa, near), backend="c")
     return q, codes
@@ -150,9 +139,11 @@ def traced(tmp_path_factory) -> Callable[..., Traced]:
 def test_recovers_the_pose_from_a_nearby_reference(actuation: str) -> None:
     rng = np.random.default_rng(31)
     checked = 0
-    for params in _robots(rng, 10):
+    for params in fk.robots(rng, 10):
         geom = fk.Geometry.from_params(params)
-        poses = np.array([p for p in _poses(rng, 12) if ne.well_conditioned(params, p, 0.05, 1e3)])
+        poses = np.array(
+            [p for p in fk.random_poses(rng, 12) if ne.well_conditioned(params, p, 0.05, 1e3)]
+        )
         if len(poses) == 0:
             continue
         qa = _qa(params, actuation, poses)
@@ -228,9 +219,9 @@ def test_agrees_with_the_prototype(actuation: str) -> None:
     mode) and the same mode as ``fk_reference.tracked_forward_kinematics``."""
     rng = np.random.default_rng(32)
     statuses = []
-    for params in _robots(rng, 12):
+    for params in fk.robots(rng, 12):
         geom = fk.Geometry.from_params(params)
-        poses = _poses(rng, 10)
+        poses = fk.random_poses(rng, 10)
         qa = _qa(params, actuation, poses)
         for spread in (0.003, 0.03, 0.3):
             near = poses + rng.normal(0, 1, poses.shape) * spread * np.array([1.0, 1.0, 10.0])
@@ -256,9 +247,9 @@ def test_a_reference_in_another_modes_basin_gives_that_mode(actuation: str, trac
     rng = np.random.default_rng(33)
     call = traced(actuation)
     hows, nearest_found, several = [], [], 0
-    for params in _robots(rng, 10):
+    for params in fk.robots(rng, 10):
         geom = fk.Geometry.from_params(params)
-        for pose in _poses(rng, 6):
+        for pose in fk.random_poses(rng, 6):
             qa = _qa(params, actuation, pose)[0]
             modes = fk.assembly_modes(geom, actuation, qa)
             several += len(modes) > 1
@@ -294,9 +285,9 @@ def test_fallback_when_newton_is_cut_short(actuation: str, max_iter: int, traced
     rng = np.random.default_rng(34)
     call = traced(actuation, max_iter=max_iter)
     hows = []
-    for params in _robots(rng, 8):
+    for params in fk.robots(rng, 8):
         geom = fk.Geometry.from_params(params)
-        for pose in _poses(rng, 6):
+        for pose in fk.random_poses(rng, 6):
             qa = _qa(params, actuation, pose)[0]
             near = pose + rng.normal(0, [0.02, 0.02, 0.3])
             code, q, steps, how = call(params, qa, near)
@@ -441,9 +432,9 @@ def test_single_and_batch_are_bit_identical(actuation: str) -> None:
     """References near and far (Newton and the fallback), and samples with no mode."""
     rng = np.random.default_rng(35)
     counts = np.zeros(4, dtype=int)
-    for params in _robots(rng, 4):
+    for params in fk.robots(rng, 4):
         model = _model(params, actuation)
-        poses = _poses(rng, 40)
+        poses = fk.random_poses(rng, 40)
         qa = np.concatenate([_qa(params, actuation, poses), _no_mode_inputs(actuation)])
         near = np.concatenate(
             [poses + rng.normal(0, [0.05, 0.05, 0.5], poses.shape), np.zeros((len(qa) - 40, 3))]
