@@ -103,6 +103,7 @@ def build_mjcf(
         raise ValueError(f"actuation must be one of {ACTUATIONS}, got {actuation!r}")
     p = {k: float(v) for k, v in params.items()}
     l0, l2, c1, c2 = p["l0"], p["l2"], p["c1"], p["c2"]
+    c1p, c2p = p.get("c1_perp", 0.0), p.get("c2_perp", 0.0)  # along the body's y = n
 
     legs = []
     for leg in LEGS:
@@ -111,13 +112,13 @@ def build_mjcf(
             f"""
     <body name="cylinder_{leg}" pos="{_vec(a1)}" euler="0 0 {_num(p[f"alpha_{leg}"])}">
       <joint name="phi10_{leg}" type="hinge" axis="0 0 1"/>
-      <inertial pos="{_num(c1)} 0 0" mass="{_num(p["m1"])}"
+      <inertial pos="{_num(c1)} {_num(c1p)} 0" mass="{_num(p["m1"])}"
                 diaginertia="{_vec((_ROD_AXIAL * p["J1"], p["J1"], p["J1"]))}"/>
       <geom type="capsule" fromto="0 0 0 {_num(2 * c1)} 0 0" size="{_GEOM_RADIUS}"
             rgba="0.3 0.4 0.8 1"/>
       <body name="piston_{leg}" pos="{_num(l0)} 0 0">
         <joint name="lambda21_{leg}" type="slide" axis="1 0 0"/>
-        <inertial pos="{_num(c2)} 0 0" mass="{_num(p["m2"])}"
+        <inertial pos="{_num(c2)} {_num(c2p)} 0" mass="{_num(p["m2"])}"
                   diaginertia="{_vec((_ROD_AXIAL * p["J2"], p["J2"], p["J2"]))}"/>
         <geom type="capsule" fromto="0 0 0 {_num(l2)} 0 0" size="{_GEOM_RADIUS / 2}"
               rgba="0.8 0.8 0.8 1"/>

@@ -6,9 +6,10 @@ production code against it check the symbolic virtual-work derivation against pl
 
 Model (per leg L in A, B, C; world frame x0 horizontal, y0 up, z0 out of the plane):
 
-- body 1, cylinder: turns about the base pivot ``A1``; COM at ``A1 + c1 e``; mass m1, inertia J1.
+- body 1, cylinder: turns about the base pivot ``A1``; COM at ``A1 + c1 e + c1_perp n``
+  (``n`` = ``e`` turned by +90 deg); mass m1, inertia J1 about the COM.
 - body 2, piston: slides along the leg axis ``e``; ``A2 = A1 + (l0 + lambda21) e``; COM at
-  ``A2 + c2 e``; turns with the cylinder; mass m2, inertia J2.
+  ``A2 + c2 e + c2_perp n``; turns with the cylinder; mass m2, inertia J2 about the COM.
 - body 3, platform (shared): COM at G; joint ``A3 = G + R(phi) p``, ``|A2 A3| = l2``; mass m3,
   inertia J3 about G.
 
@@ -62,6 +63,8 @@ PARAM_NAMES: tuple[str, ...] = (
     "fx",
     "fy",
     "mz",
+    "c1_perp",
+    "c2_perp",
 )
 FAMILIES = (
     "phi10",
@@ -126,6 +129,8 @@ def paper_params() -> dict[str, float]:
         fx=0.0,
         fy=0.0,
         mz=0.0,
+        c1_perp=0.0,
+        c2_perp=0.0,
     )
     return {name: float(p[name]) for name in PARAM_NAMES}
 
@@ -181,6 +186,7 @@ def kinematics(params: Mapping[str, float], q, qd, qdd=None) -> dict:
     if qdd is not None:
         out["platform"].update(a=qdd[:, :2], eps=qdd[:, 2])
     l0, l2, c1, c2 = (params[k] for k in ("l0", "l2", "c1", "c2"))
+    c1p, c2p = params["c1_perp"], params["c2_perp"]
     for leg in LEGS:
         A1 = np.array([params[f"x{leg}1"], params[f"y{leg}1"]])
         px, py = params[f"x{leg}3"], params[f"y{leg}3"]
@@ -194,7 +200,9 @@ def kinematics(params: Mapping[str, float], q, qd, qdd=None) -> dict:
         vA3 = vG + w[:, None] * _perp(rho)
         Ld = np.einsum("ij,ij->i", e, vA3)
         thd = np.einsum("ij,ij->i", n, vA3) / length
-        sp = length - l2 + c2  # |A1 C2| = l0 + lambda21 + c2
+        sp = length - l2 + c2  # A1 -> C2 along e: l0 + lambda21 + c2
+        r1 = c1 * e + c1p * n  # A1 -> C1, fixed in the cylinder
+        r2 = sp[:, None] * e + c2p * n  # A1 -> C2
         lam = length - l0 - l2
         k = {
             "A1": np.broadcast_to(A1, d.shape),
@@ -202,8 +210,8 @@ def kinematics(params: Mapping[str, float], q, qd, qdd=None) -> dict:
             "A2": A1 + (length - l2)[:, None] * e,
             "e": e,
             "n": n,
-            "C1": A1 + c1 * e,
-            "C2": A1 + sp[:, None] * e,
+            "C1": A1 + r1,
+            "C2": A1 + r2,
             "length": length,
             "theta": theta,
             "phi10": _wrap(theta - params[f"alpha_{leg}"]),
@@ -211,8 +219,8 @@ def kinematics(params: Mapping[str, float], q, qd, qdd=None) -> dict:
             "omega10": thd,
             "v21": Ld,
             "omega32": w - thd,
-            "v1": c1 * thd[:, None] * n,
-            "v2": Ld[:, None] * e + (sp * thd)[:, None] * n,
+            "v1": thd[:, None] * _perp(r1),
+            "v2": Ld[:, None] * e + thd[:, None] * _perp(r2),
         }
         k["phi32"] = phi - k["phi10"]
         if qdd is not None:
@@ -223,8 +231,11 @@ def kinematics(params: Mapping[str, float], q, qd, qdd=None) -> dict:
                 eps10=thdd,
                 gamma21=Ldd,
                 eps32=qdd[:, 2] - thdd,
-                a1=c1 * (thdd[:, None] * n - (thd**2)[:, None] * e),
-                a2=(Ldd - sp * thd**2)[:, None] * e + (sp * thdd + 2 * Ld * thd)[:, None] * n,
+                a1=thdd[:, None] * _perp(r1) - (thd**2)[:, None] * r1,
+                a2=Ldd[:, None] * e
+                + (2 * Ld * thd)[:, None] * n
+                + thdd[:, None] * _perp(r2)
+                - (thd**2)[:, None] * r2,
             )
         out[leg] = k
     return out
@@ -485,6 +496,9 @@ def random_robot(rng: np.random.Generator) -> dict:
         fy=float(rng.uniform(-20, 20)),
         mz=float(rng.uniform(-3, 3)),
     )
+    # Centres of mass off the leg axis, in [-0.2, 0.2] l, taken from the draws of c1, c2 rather
+    # than drawn: a further draw would change every later robot of a seeded sequence.
+    p.update(c1_perp=p["c1"] - 0.5 * l1, c2_perp=p["c2"] - 0.5 * l2)
     return {
         "params": {k: float(p[k]) for k in PARAM_NAMES},
         "l1": l1,
@@ -568,6 +582,7 @@ def body_residuals(
     m1, m2, m3 = params["m1"], params["m2"], params["m3"]
     J1, J2, J3 = params["J1"], params["J2"], params["J3"]
     l0, l2, c1, c2 = (params[k] for k in ("l0", "l2", "c1", "c2"))
+    c1p, c2p = params["c1_perp"], params["c2_perp"]
     G, phi = q[:, :2], q[:, 2]
     res: dict[str, np.ndarray] = {}
     plat_f = m3 * g + np.array([params["fx"], params["fy"]]) - m3 * qdd[:, :2]
@@ -584,8 +599,10 @@ def body_residuals(
         s2 = l0 + o("lambda21")  # |A1 A2|
         A2 = A1 + s2[:, None] * e
         A3 = A2 + l2 * e
-        C1 = A1 + c1 * e
-        C2 = A2 + c2 * e
+        r1 = c1 * e + c1p * n  # A1 -> C1
+        r2 = (s2 + c2)[:, None] * e + c2p * n  # A1 -> C2
+        C1 = A1 + r1
+        C2 = A1 + r2
         p = np.array([params[f"x{leg}3"], params[f"y{leg}3"]])
         rho = np.stack(
             [np.cos(phi) * p[0] - np.sin(phi) * p[1], np.sin(phi) * p[0] + np.cos(phi) * p[1]],
@@ -594,9 +611,13 @@ def body_residuals(
         res[f"closure_{leg}"] = A3 - (G + rho)
         w, eps = o("omega10"), o("eps10")
         sd, sdd = o("v21"), o("gamma21")
-        a1 = c1 * (eps[:, None] * n - (w**2)[:, None] * e)
-        sp = s2 + c2
-        a2 = (sdd - sp * w**2)[:, None] * e + (sp * eps + 2 * sd * w)[:, None] * n
+        a1 = eps[:, None] * _perp(r1) - (w**2)[:, None] * r1
+        a2 = (
+            sdd[:, None] * e
+            + (2 * sd * w)[:, None] * n
+            + eps[:, None] * _perp(r2)
+            - (w**2)[:, None] * r2
+        )
         f10 = np.stack([o("f10x"), o("f10y")], axis=-1)
         f21 = o("f21y")[:, None] * n + o("f21z")[:, None] * e
         m21z = -o("m21")  # moment of the cylinder on the piston about +z0

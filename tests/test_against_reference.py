@@ -302,7 +302,10 @@ def random_run(tmp_path_factory):
                 alpha_deg=robot["alpha_deg"],
                 base=robot["base"],
                 platform=robot["platform"],
-                mass={k: p[k] for k in ("m1", "m2", "m3", "c1", "c2", "J1", "J2", "J3")},
+                mass={
+                    k: p[k]
+                    for k in ("m1", "m2", "m3", "c1", "c2", "c1_perp", "c2_perp", "J1", "J2", "J3")
+                },
                 gravity=(p["gx"], p["gy"]),
                 force=(p["fx"], p["fy"]),
                 moment=p["mz"],

@@ -133,7 +133,7 @@ def test_paper_legs_are_symmetrically_extended() -> None:
 def test_params_order_vector_and_immutability() -> None:
     model = load_model()
     assert tuple(model.params) == PARAM_NAMES
-    assert len(PARAM_NAMES) == 30
+    assert len(PARAM_NAMES) == 32
     v = model.vector()
     assert v.dtype == np.float64
     assert v.shape == (len(PARAM_NAMES),)
@@ -167,15 +167,19 @@ def test_explicit_form_matches_symmetric(tmp_path: Path) -> None:
 
 def test_optional_values_override_defaults(tmp_path: Path) -> None:
     text = PAPER.replace(
-        "m3 = 5.0", "m3 = 5.0\nc1 = 0.05\nc2 = 0.15\nJ1 = 0.02\nJ2 = 0.03\nJ3 = 0.2"
+        "m3 = 5.0",
+        "m3 = 5.0\nc1 = 0.05\nc2 = 0.15\nc1_perp = 0.01\nc2_perp = -0.02\nJ1 = 0.02\nJ2 = 0.03\n"
+        "J3 = 0.2",
     )
     text = text.replace("gravity = [0.0, -9.81]", "gravity = [1, -9]")
     text = text.replace("force = [0.0, 0.0]\nmoment = 0.0", "force = [2.0, -3.0]\nmoment = 0.5")
     text = text.replace('actuation = "revolute"', 'actuation = "prismatic"')
     model = load_model(write(tmp_path, text))
-    got = {k: model.params[k] for k in ("c1", "c2", "J1", "J2", "J3", "gx", "gy", "fx", "fy", "mz")}
+    keys = ("c1", "c2", "c1_perp", "c2_perp", "J1", "J2", "J3", "gx", "gy", "fx", "fy", "mz")
+    got = {k: model.params[k] for k in keys}
     assert got == {
-        "c1": 0.05, "c2": 0.15, "J1": 0.02, "J2": 0.03, "J3": 0.2,
+        "c1": 0.05, "c2": 0.15, "c1_perp": 0.01, "c2_perp": -0.02, "J1": 0.02, "J2": 0.03,
+        "J3": 0.2,
         "gx": 1.0, "gy": -9.0, "fx": 2.0, "fy": -3.0, "mz": 0.5,
     }  # fmt: skip
     assert model.actuation == "prismatic"

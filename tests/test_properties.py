@@ -63,6 +63,8 @@ def robots(draw) -> dict[str, float]:
         fx=draw(st.floats(-20, 20)),
         fy=draw(st.floats(-20, 20)),
         mz=draw(st.floats(-3, 3)),
+        c1_perp=draw(st.floats(-0.2, 0.2)) * l1,
+        c2_perp=draw(st.floats(-0.2, 0.2)) * l2,
     )
     return p
 
@@ -177,7 +179,8 @@ def test_at_rest_the_loads_balance_gravity_and_payload(params, motion, actuation
         e = np.stack([np.cos(theta), np.sin(theta)], 1)
         f10 = np.stack([out[f"f10x_{k}"], out[f"f10y_{k}"]], 1)
         moment += out[f"m10_{k}"] + a1[0] * f10[:, 1] - a1[1] * f10[:, 0]
-        moment += cross(a1 + p["c1"] * e, weights["m1"])
-        piston = a1 + (p["l0"] + out[f"lambda21_{k}"] + p["c2"])[:, None] * e
+        n = np.stack([-e[:, 1], e[:, 0]], 1)
+        moment += cross(a1 + p["c1"] * e + p["c1_perp"] * n, weights["m1"])
+        piston = a1 + (p["l0"] + out[f"lambda21_{k}"] + p["c2"])[:, None] * e + p["c2_perp"] * n
         moment += cross(piston, weights["m2"])
     assert np.max(np.abs(moment)) <= 1e-9 * max(scale, 1.0)

@@ -121,6 +121,7 @@ def manifest(module: ModuleSpec, digest: str, files: dict[str, str]) -> str:
         "thresholds": [
             {"name": t.name, "value": t.value, "meaning": t.meaning} for t in module.thresholds
         ],
+        "tables": {f"{prefix}_{t.table}": _components(t) for t in module.tables},
         "functions": [
             {
                 "name": f.name,

@@ -185,7 +185,9 @@ class ModuleSpec:
 
     ``prefix`` starts every C name (``rpr3_inverse_dynamics``, ``RPR3_OK``) and the generated
     files' names (``rpr3.h``, ``rpr3.c``, ``rpr3_numpy.py``). ``defines`` are extra C macros,
-    ``(name, C literal, comment)``.
+    ``(name, C literal, comment)``. ``tables`` are extra name tables (each an :class:`Argument`
+    with a ``table``), for indices that no function's input or output names one by one (e.g.
+    the columns of a matrix output).
     """
 
     prefix: str
@@ -196,8 +198,11 @@ class ModuleSpec:
     return_codes: tuple[ReturnCode, ...]
     thresholds: tuple[Threshold, ...] = ()
     defines: tuple[tuple[str, str, str], ...] = field(default_factory=tuple)
+    tables: tuple[Argument, ...] = field(default_factory=tuple)
 
     def __post_init__(self) -> None:
+        if any(t.table is None for t in self.tables):
+            raise ValueError("an extra name table needs a table name")
         codes = {c.name for c in self.return_codes}
         thresholds = {t.name for t in self.thresholds}
         if "OK" not in codes or next(c for c in self.return_codes if c.name == "OK").value != 0:

@@ -81,6 +81,8 @@ def _param_doc(name: str) -> tuple[str, str]:
         "l2": ("m", "|A2A3|"),
         "c1": ("m", "cylinder centre of mass at A1 + c1 e"),
         "c2": ("m", "piston centre of mass at A2 + c2 e"),
+        "c1_perp": ("m", "cylinder centre of mass off the leg axis: A1 + c1 e + c1_perp n"),
+        "c2_perp": ("m", "piston centre of mass off the leg axis: A2 + c2 e + c2_perp n"),
         "m1": ("kg", "cylinder mass"),
         "m2": ("kg", "piston mass"),
         "m3": ("kg", "platform mass"),

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import sympy as sp
 from rpr3gen_derive.codegen.program import Program
 from rpr3gen_derive.rpr3 import symbols as syms
-from rpr3gen_derive.rpr3.frames import skew, u1, u3
+from rpr3gen_derive.rpr3.frames import skew, u1, u2, u3
 from rpr3gen_derive.rpr3.kinematics import LegKinematics
 
 STEP_INERTIA = "inertia forces and moments of each body"
@@ -110,11 +110,18 @@ def leg_wrenches(prog: Program, kin: LegKinematics, carries_platform: bool) -> L
     g3 = kin.a30 * syms.gravity  # = a32 g2, with a30 = a32 a21 a10 = rot(z, phi)
     # Inertia tensors about the joint point; only the component on the rotation axis acts in
     # planar motion (z1 for the cylinder, x2 = -z0 for the piston, z3 for the platform).
+    # Centres of mass off the leg axis by c1_perp, c2_perp along n (y1 = y2 = n).
+    c1, c1p = syms.c1, syms.params["c1_perp"]
+    c2, c2p = syms.c2, syms.params["c2_perp"]
     F10, M10 = required_wrench(
-        cyl, syms.m1, syms.c1 * u1, sp.diag(0, 0, syms.J1 + syms.m1 * syms.c1**2), g1
+        cyl, syms.m1, c1 * u1 + c1p * u2, sp.diag(0, 0, syms.J1 + syms.m1 * (c1**2 + c1p**2)), g1
     )
     F20, M20 = required_wrench(
-        piston, syms.m2, syms.c2 * u3, sp.diag(syms.J2 + syms.m2 * syms.c2**2, 0, 0), g2
+        piston,
+        syms.m2,
+        c2 * u3 + c2p * u2,
+        sp.diag(syms.J2 + syms.m2 * (c2**2 + c2p**2), 0, 0),
+        g2,
     )
     step = STEP_INERTIA
     F10 = prog.define_vector(f"F10_{leg}", F10, step)

@@ -245,9 +245,14 @@ def regressor(prog: Program, actuation: str) -> sp.Matrix:
 
 def payload_efforts(prog: Program, actuation: str) -> sp.Matrix:
     """``tau_payload`` (3): the efforts at ``pi = 0``, which hold the payload wrench (fx, fy,
-    mz at G) at rest, eqs. (12)-(17) with only the payload in ``F_3``, ``M_3``."""
+    mz at G) at rest, eqs. (12)-(17) with only the payload in ``F_3``, ``M_3``.
+
+    Without mass nothing depends on the velocity or the acceleration (the payload wrench is
+    given, the virtual velocities are geometric), so they are set to zero too: the result is a
+    function of the pose (and the geometry and payload) alone.
+    """
     taus = efforts(prog, actuation)
-    symbols = [pi_symbols[n] for n in INERTIAL_PARAMETER_NAMES]
+    symbols = [pi_symbols[n] for n in INERTIAL_PARAMETER_NAMES] + [*syms.qd, *syms.qdd]
     return sp.Matrix(at_zero(prog, taus, symbols, "_pi0", STEP_PAYLOAD))
 
 
@@ -258,14 +263,19 @@ def payload_efforts(prog: Program, actuation: str) -> sp.Matrix:
 def inertial_parameters(params: Mapping[str, float], identical_legs: bool = False) -> np.ndarray:
     """The model's ``pi`` (P,), in the order of :func:`parameter_names`.
 
-    Cylinder: ``m1, m1 c1, 0, J1 + m1 c1^2`` (about A1); piston: ``m2, m2 c2, 0,
-    J2 + m2 c2^2`` (about A2); platform: ``m3, 0, 0, J3`` (COM at G). The model's legs are
-    identical, so with ``identical_legs`` the leg values appear once (P = 12).
+    Cylinder: ``m1, m1 c1, m1 c1_perp, J1 + m1 (c1^2 + c1_perp^2)`` (about A1); piston:
+    ``m2, m2 c2, m2 c2_perp, J2 + m2 (c2^2 + c2_perp^2)`` (about A2); platform: ``m3, 0, 0, J3``
+    (COM at G). The model's legs are identical, so with ``identical_legs`` the leg values appear
+    once (P = 12).
     """
     p = params
+
+    def body(m: float, c: float, c_perp: float, j: float) -> tuple[float, ...]:
+        return (m, m * c, m * c_perp, j + m * (c**2 + c_perp**2))
+
     leg = {
-        "1": (p["m1"], p["m1"] * p["c1"], 0.0, p["J1"] + p["m1"] * p["c1"] ** 2),
-        "2": (p["m2"], p["m2"] * p["c2"], 0.0, p["J2"] + p["m2"] * p["c2"] ** 2),
+        "1": body(p["m1"], p["c1"], p.get("c1_perp", 0.0), p["J1"]),
+        "2": body(p["m2"], p["c2"], p.get("c2_perp", 0.0), p["J2"]),
     }
     platform = (p["m3"], 0.0, 0.0, p["J3"])
     if identical_legs:

@@ -24,7 +24,7 @@ from rpr3gen_derive.codegen.spec import (
     ReturnCode,
     Threshold,
 )
-from rpr3gen_derive.rpr3 import control, direct_kinematics
+from rpr3gen_derive.rpr3 import control, direct_kinematics, identification
 from rpr3gen_derive.rpr3 import symbols as syms
 from rpr3gen_derive.rpr3.derivation import (
     ACTUATIONS,
@@ -620,6 +620,103 @@ def forward_kinematics(actuation: str) -> FunctionSpec:
     )
 
 
+# -- dynamic identification: the regressor and the payload's efforts (docs/identification.md) --
+
+#: Unit of each inertial quantity (docs/identification.md).
+_PI_UNITS = {"m": "kg", "mcx": "kg m", "mcy": "kg m", "Jzz": "kg m^2"}
+#: Unit of Y's entries per actuation and quantity: the effort's unit over the parameter's.
+_Y_UNITS = {
+    "revolute": {"m": "m^2/s^2", "mcx": "m/s^2", "mcy": "m/s^2", "Jzz": "1/s^2"},
+    "prismatic": {"m": "m/s^2", "mcx": "1/s^2", "mcy": "1/s^2", "Jzz": "1/(m s^2)"},
+}
+
+
+_QUANTITY = {"m": "mass", "mcx": "first moment x", "mcy": "first moment y", "Jzz": "inertia"}
+_BODY = {"1": "cylinder", "2": "piston", "3": "platform"}
+
+
+def _pi_component(name: str) -> Component:
+    """``mcx_2B`` -> unit and meaning (docs/identification.md)."""
+    quantity, body = name.split("_")
+    leg = f" of leg {body[1]}" if len(body) > 1 else ""
+    return Component(
+        name, _PI_UNITS[quantity], f"{_QUANTITY[quantity]} of the {_BODY[body[0]]}{leg}"
+    )
+
+
+#: The inertial parameters pi, the columns of Y: C table ``rpr3_inertial_parameter_names``.
+INERTIAL_PARAMETERS = Argument(
+    "pi",
+    tuple(identification.pi_symbols[n] for n in identification.INERTIAL_PARAMETER_NAMES),
+    tuple(_pi_component(n) for n in identification.INERTIAL_PARAMETER_NAMES),
+    "inertial parameters (per moving body: m, m cx, m cy, Jzz about its joint point)",
+    table="inertial_parameter_names",
+)
+
+
+def regressor(actuation: str) -> FunctionSpec:
+    """``rpr3_regressor``: ``Y`` (3 x P, row-major) with ``tau = Y pi + tau_payload``."""
+    prog = Program()
+    checks = _pose_checks(prog, actuation)
+    Y = identification.regressor(prog, actuation)
+    family = control.ACTUATORS[actuation].effort
+    names = identification.INERTIAL_PARAMETER_NAMES
+    units = _Y_UNITS[actuation]
+    return FunctionSpec(
+        name="regressor",
+        doc=f"Identification regressor Y (3 x {len(names)}, row-major; row i: {family} of leg "
+        "A, B, C; column j: INERTIAL_PARAMETER_NAMES[j]) with tau = Y pi + tau_payload: the "
+        "actuator efforts of eqs. (10)-(17) differentiated by the inertial parameters pi (per "
+        "moving body m, m cx, m cy, Jzz about its joint point; docs/identification.md).",
+        inputs=(POSE, VELOCITY, ACCELERATION),
+        outputs=(
+            Output(
+                "Y",
+                tuple(Y[i, j] for i in range(3) for j in range(len(names))),
+                tuple(
+                    Component(
+                        f"Y_{leg}__{name}",
+                        units[name.split("_")[0]],
+                        f"d {family}_{leg} / d {name} ({_PI_UNITS[name.split('_')[0]]})",
+                    )
+                    for leg in LEGS
+                    for name in names
+                ),
+                f"Y = d tau / d pi, row-major (3 x {len(names)}; columns: "
+                "rpr3_inertial_parameter_names)",
+            ),
+        ),
+        program=prog,
+        checks=checks,
+    )
+
+
+def payload_efforts(actuation: str) -> FunctionSpec:
+    """``rpr3_payload_efforts``: the efforts that hold the payload wrench at rest."""
+    prog = Program()
+    checks = _pose_checks(prog, actuation)
+    tau = identification.payload_efforts(prog, actuation)
+    arg = effort_argument(actuation)
+    return FunctionSpec(
+        name="payload_efforts",
+        doc="tau_payload: the actuator efforts holding the payload wrench (fx, fy at G, mz) at "
+        "rest, the part of tau = Y pi + tau_payload that scales with no inertial parameter "
+        "(eqs. 12-17 with only the payload acting); a function of the pose alone.",
+        inputs=(POSE,),
+        outputs=(
+            _triple(
+                "tau_payload",
+                tau,
+                tuple(c.name for c in arg.components),
+                tuple(c.unit for c in arg.components),
+                "efforts holding the payload",
+            ),
+        ),
+        program=prog,
+        checks=checks,
+    )
+
+
 FunctionBuilder = Callable[[str], FunctionSpec | None]
 
 #: Every generated function, by name: a builder from the actuation scheme to its spec. A builder
@@ -636,6 +733,8 @@ FUNCTIONS: Mapping[str, FunctionBuilder] = {
     "assembly_modes": assembly_modes,
     "pose_from_angle": pose_from_angle,
     "forward_kinematics": forward_kinematics,
+    "regressor": regressor,
+    "payload_efforts": payload_efforts,
 }
 
 
@@ -670,6 +769,7 @@ def module(actuation: str, functions: Mapping[str, FunctionBuilder] | None = Non
         ),
         return_codes=RETURN_CODES,
         thresholds=THRESHOLDS,
+        tables=(INERTIAL_PARAMETERS,),
         defines=(
             ("ACTUATION", f'"{actuation}"', ""),
             (

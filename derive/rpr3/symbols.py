@@ -23,6 +23,7 @@ PARAM_NAMES: tuple[str, ...] = (
     "alpha_A", "alpha_B", "alpha_C",
     "l0", "l2", "c1", "c2", "m1", "m2", "m3", "J1", "J2", "J3",
     "gx", "gy", "fx", "fy", "mz",
+    "c1_perp", "c2_perp",
 )  # fmt: skip
 
 _POSITIVE = {"l0", "l2", "m1", "m2", "m3", "J1", "J2", "J3"}

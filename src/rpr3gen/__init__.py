@@ -28,6 +28,7 @@ from rpr3gen.control import (
     task_space_dynamics,
 )
 from rpr3gen.errors import (
+    IdentificationError,
     InputError,
     InputTypeError,
     ModelError,
@@ -35,6 +36,16 @@ from rpr3gen.errors import (
     Rpr3genWarning,
     TrajectoryError,
     TrajectoryWarning,
+)
+from rpr3gen.excitation import excite
+from rpr3gen.identification import (
+    INERTIAL_PARAMETER_NAMES,
+    base_parameters,
+    base_regressor,
+    identify,
+    inertial_parameters,
+    payload_efforts,
+    regressor,
 )
 from rpr3gen.model import PARAM_NAMES, Model, load_model
 from rpr3gen.sample import SampleEvaluator
@@ -47,8 +58,10 @@ except importlib.metadata.PackageNotFoundError:  # the source tree on sys.path, 
 
 __all__ = [
     "BACKENDS",
+    "INERTIAL_PARAMETER_NAMES",
     "OUTPUT_NAMES",
     "PARAM_NAMES",
+    "IdentificationError",
     "InputError",
     "InputTypeError",
     "Model",
@@ -64,15 +77,22 @@ __all__ = [
     "actuator_efforts",
     "actuator_jacobian",
     "assembly_modes",
+    "base_parameters",
+    "base_regressor",
     "evaluate",
+    "excite",
     "forward_dynamics",
     "forward_kinematics",
+    "identify",
+    "inertial_parameters",
     "inverse_dynamics",
     "jacobian_rate",
     "load_model",
     "paper_trajectory",
+    "payload_efforts",
     "platform_radius",
     "platform_velocity",
     "read_trajectory_csv",
+    "regressor",
     "task_space_dynamics",
 ]

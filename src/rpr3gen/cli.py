@@ -1,5 +1,5 @@
-"""The ``rpr3gen`` command: ``simulate``, ``paper`` (the paper's two examples), ``params`` and
-``generate``.
+"""The ``rpr3gen`` command: ``simulate``, ``paper`` (the paper's two examples), ``params``,
+``fk``, ``identify``, ``excite`` (:mod:`rpr3gen.cli_identification`) and ``generate``.
 
 Every failure is one line on stderr (``rpr3gen: error: ...``) and exit status 2; ``--debug``
 shows the traceback instead. The package's warnings are one line each (``rpr3gen: warning:
@@ -20,7 +20,7 @@ from typing import NoReturn, TextIO
 
 import numpy as np
 
-from rpr3gen import __version__, manifest
+from rpr3gen import __version__, cli_identification, manifest
 from rpr3gen.backends import BACKENDS, OUTPUT_NAMES, inverse_dynamics
 from rpr3gen.errors import (
     InputError,
@@ -176,6 +176,8 @@ def _parser() -> argparse.ArgumentParser:
         "(default: the installed generated package)",
     )
     fk.add_argument("qa", nargs=3, type=float, metavar="QA", help="actuator coordinate")
+
+    cli_identification.add_parsers(sub, paper_model)
 
     gen = sub.add_parser("generate", help="derive and write the generated sources")
     gen.add_argument(
@@ -477,6 +479,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         "params": _cmd_params,
         "fk": _cmd_fk,
         "generate": _cmd_generate,
+        "identify": cli_identification.cmd_identify,
+        "excite": cli_identification.cmd_excite,
     }
     try:
         with _warnings_as_lines():

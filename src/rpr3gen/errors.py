@@ -54,6 +54,11 @@ class InputError(Rpr3genError, ValueError):
     """An array or argument given to the Python API has a bad shape or value."""
 
 
+class IdentificationError(Rpr3genError, ValueError):
+    """Identification data cannot determine the parameters (too little excitation, too few
+    samples)."""
+
+
 class InputTypeError(Rpr3genError, TypeError):
     """An argument given to the Python API has the wrong type."""
 

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import json
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import cache
 from importlib import resources
 from pathlib import Path
@@ -83,6 +83,7 @@ class Variant:
     code_meanings: dict[int, str]
     thresholds: dict[str, float]
     functions: dict[str, FunctionInfo]
+    tables: dict[str, tuple[str, ...]] = field(default_factory=dict)  # extra name tables
 
     def function(self, name: str) -> FunctionInfo:
         """The function called ``name`` (without the prefix), or a clear error."""
@@ -181,6 +182,9 @@ def _load(folder: Path, variant: str) -> Variant:
         code_meanings={int(c["value"]): c["meaning"] for c in data["return_codes"]},
         thresholds=thresholds,
         functions={f["name"]: _function(f, codes, thresholds) for f in data["functions"]},
+        tables={
+            name: tuple(c["name"] for c in comps) for name, comps in data.get("tables", {}).items()
+        },
     )
 
 

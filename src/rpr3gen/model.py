@@ -53,7 +53,7 @@ _SCHEMA: dict[str, Any] = {
     "name": None,
     "actuation": None,
     "geometry": dict.fromkeys(("l0", "l1", "l2", "alpha_deg", *_SYMMETRIC_KEYS, *_EXPLICIT_KEYS)),
-    "mass": dict.fromkeys(("m1", "m2", "m3", "c1", "c2", "J1", "J2", "J3")),
+    "mass": dict.fromkeys(("m1", "m2", "m3", "c1", "c2", "c1_perp", "c2_perp", "J1", "J2", "J3")),
     "environment": {"gravity": None},
     "payload": {"force": None, "moment": None},
     "limits": {"stroke": None},
@@ -436,13 +436,17 @@ class _Reader:
     def mass(
         self, m: Mapping[str, Any], params: dict[str, float], *, l1: float, r: float | None
     ) -> None:
-        """Fill c1, c2, m1..m3 and J1..J3 into ``params`` (defaults: docs/conventions.md)."""
+        """Fill c1, c2, c1_perp, c2_perp, m1..m3 and J1..J3 into ``params`` (defaults:
+        docs/conventions.md; the centres of mass are on the leg axis unless c1_perp, c2_perp,
+        along the leg's normal n, say otherwise)."""
         l2 = params["l2"]
         m1 = self.number(m, "mass.m1", "m1", positive=True)
         m2 = self.number(m, "mass.m2", "m2", positive=True)
         m3 = self.number(m, "mass.m3", "m3", positive=True)
         params["c1"] = self.number(m, "mass.c1", "c1", default=l1 / 2)
         params["c2"] = self.number(m, "mass.c2", "c2", default=l2 / 2)
+        params["c1_perp"] = self.number(m, "mass.c1_perp", "c1_perp", default=0.0)
+        params["c2_perp"] = self.number(m, "mass.c2_perp", "c2_perp", default=0.0)
         params["J1"] = self.number(m, "mass.J1", "J1", default=m1 * l1**2 / 12, positive=True)
         params["J2"] = self.number(m, "mass.J2", "J2", default=m2 * l2**2 / 12, positive=True)
         if r is None:

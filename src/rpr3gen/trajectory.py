@@ -16,7 +16,7 @@ import difflib
 import math
 import os
 import warnings
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from types import MappingProxyType
 from typing import TextIO
@@ -201,12 +201,24 @@ def read_trajectory_csv(
         TrajectoryWarning: If the file's velocities or accelerations disagree with its
             positions (a ``UserWarning``; the command prints it as one line).
     """
+    traj, _ = read_trajectory_columns(path, (), smoothing=smoothing)
+    return traj
+
+
+def read_trajectory_columns(
+    path: str | os.PathLike[str], extra: Sequence[str], *, smoothing: float | None = None
+) -> tuple[Trajectory, np.ndarray]:
+    """:func:`read_trajectory_csv` of a file that also has the columns ``extra`` (required,
+    checked as the trajectory's are): the trajectory and those columns, (n, len(extra)).
+
+    Used for identification data: a trajectory plus the measured actuator efforts.
+    """
     source = os.fspath(path)
     if smoothing is not None:
         smoothing = check_smoothing(smoothing)
     try:
         with open(source, encoding="utf-8-sig", newline="") as f:
-            data = _parse(f, source)
+            table = _parse(f, source, tuple(extra))
     except FileNotFoundError:
         raise TrajectoryError(f"{source}: trajectory file not found") from None
     except IsADirectoryError:
@@ -218,9 +230,10 @@ def read_trajectory_csv(
         raise TrajectoryError(f"{source}: malformed CSV: {exc}") from None
     except OSError as exc:
         raise TrajectoryError(f"{source}: cannot read: {exc.strerror or exc}") from None
+    data, columns = table[:, : table.shape[1] - len(extra)], table[:, table.shape[1] - len(extra) :]
     t, q = data[:, 0], data[:, 1:4]
     if data.shape[1] == len(POSITION_COLUMNS):
-        return Trajectory.from_positions(t, q, smoothing or 0.0, source=source)
+        return Trajectory.from_positions(t, q, smoothing or 0.0, source=source), columns
     if smoothing is not None:
         raise TrajectoryError(
             f"{source}: smoothing is for a file of positions only (t,x,y,phi); this one gives "
@@ -229,12 +242,13 @@ def read_trajectory_csv(
     traj = Trajectory(t=t, q=q, qd=data[:, 4:7], qdd=data[:, 7:10])
     problem = mismatch(traj.t, traj.q, traj.qd, traj.qdd)
     if problem:
-        warnings.warn(f"{source}: {problem}", TrajectoryWarning, stacklevel=2)
-    return traj
+        warnings.warn(f"{source}: {problem}", TrajectoryWarning, stacklevel=3)
+    return traj, columns
 
 
-def _parse(f: TextIO, source: str) -> np.ndarray:
-    """The table of a trajectory file: columns :data:`CSV_COLUMNS` or :data:`POSITION_COLUMNS`."""
+def _parse(f: TextIO, source: str, extra: tuple[str, ...] = ()) -> np.ndarray:
+    """The table of a trajectory file: columns :data:`CSV_COLUMNS` or :data:`POSITION_COLUMNS`,
+    then the required columns ``extra``."""
     reader = csv.reader(f)
     header: list[str] | None = None
     for row in reader:
@@ -247,17 +261,17 @@ def _parse(f: TextIO, source: str) -> np.ndarray:
 
     index: dict[str, int] = {}
     for i, name in enumerate(header):
-        if name in CSV_COLUMNS and name in index:
+        if (name in CSV_COLUMNS or name in extra) and name in index:
             raise TrajectoryError(
                 f"{source}: line {header_line} (header): column {name!r} appears twice"
             )
         index.setdefault(name, i)
     # Positions alone, or everything: a file with some of the derivatives lacks the others.
     given = any(name in index for name in CSV_COLUMNS[len(POSITION_COLUMNS) :])
-    columns = CSV_COLUMNS if given else POSITION_COLUMNS
+    columns = (*(CSV_COLUMNS if given else POSITION_COLUMNS), *extra)
     for name in columns:
         if name not in index:
-            others = [h for h in header if h not in CSV_COLUMNS]
+            others = [h for h in header if h not in columns]
             match = difflib.get_close_matches(name, others, n=1)
             hint = f" (found {match[0]!r})" if match else ""
             raise TrajectoryError(

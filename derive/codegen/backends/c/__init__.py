@@ -149,6 +149,7 @@ def render(
     with stage("print"):
         functions = [_function(module, c) for c in compiled]
     tables = [(table_count(module.params.table or "param_names"), module.params)]
+    tables += [(table_count(str(t.table)), t) for t in module.tables]
     for c in compiled:
         tables += [(table_count(o.table), o) for o in c.spec.outputs if o.table]
     uses_finite = any(f["input_code"] or f["checks"] for f in functions)

@@ -50,6 +50,7 @@ def render(
                 }
             )
     tables = [(table_count(module.params.table or "param_names"), module.params)]
+    tables += [(table_count(str(t.table)), t) for t in module.tables]
     for c in compiled:
         tables += [(table_count(o.table), o) for o in c.spec.outputs if o.table]
     with stage("render"):

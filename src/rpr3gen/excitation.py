@@ -1,0 +1,245 @@
+"""Exciting trajectories for identification: a finite Fourier series optimised for the regressor.
+
+A motion identifies the base parameters well when the stacked base regressor ``W`` (every
+sample's ``Yb``, :func:`rpr3gen.identification.base_regressor`) is well conditioned (Swevers,
+Ganseman, Tukel, De Schutter and Van Brussel 1997; Gautier and Khalil 1992). The paper's two
+motions are not: along either, W loses a rank (docs/identification.md). :func:`excite`
+optimises, per platform coordinate k (x, y, phi), the periodic motion
+
+    q_k(t) = q0_k + sum_{l=1..L} ( a_kl sin(l w t) - b_kl cos(l w t) ) / (l w),   w = 2 pi / T
+
+(so ``q_k'`` is ``sum a_kl cos + b_kl sin``: the coefficients are velocity amplitudes) to
+minimise ``log cond(W)`` (columns scaled to unit norm) inside the workspace: every sample
+reachable and clear of singularities (``conditioning >= min_conditioning``), piston strokes
+within the model's ``[limits] stroke`` (or ``|lambda21| <= l0 / 2`` when it sets none), and the
+platform's accelerations within bounds. SciPy's SLSQP does the optimisation, with the
+constraints at every sample.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.optimize
+
+from rpr3gen import manifest
+from rpr3gen.backends import evaluate
+from rpr3gen.control import platform_radius
+from rpr3gen.errors import IdentificationError, InputError
+from rpr3gen.identification import base_parameters, friction_columns, shared_matrix
+from rpr3gen.model import LEGS, Model
+from rpr3gen.trajectory import Trajectory
+
+__all__ = ["Excitation", "FourierMotion", "excite"]
+
+
+@dataclass(frozen=True)
+class FourierMotion:
+    """The periodic motion of the module docstring: ``offset`` (3,), ``a``, ``b`` (3, L)."""
+
+    period: float
+    offset: np.ndarray
+    a: np.ndarray
+    b: np.ndarray
+
+    def at(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``q, q', q''`` (n, 3) at the times ``t``."""
+        t = np.asarray(t, dtype=float)
+        w = 2 * math.pi / self.period
+        harmonics = np.arange(1, self.a.shape[1] + 1) * w  # (L,)
+        s, c = np.sin(np.outer(t, harmonics)), np.cos(np.outer(t, harmonics))  # (n, L)
+        q = self.offset + (s @ (self.a / harmonics).T) - (c @ (self.b / harmonics).T)
+        qd = c @ self.a.T + s @ self.b.T
+        qdd = -(s @ (self.a * harmonics).T) + c @ (self.b * harmonics).T
+        return q, qd, qdd
+
+    def trajectory(self, samples: int) -> Trajectory:
+        """One period sampled at ``samples`` times from 0 to ``period`` (both ends)."""
+        t = np.linspace(0.0, self.period, samples)
+        return Trajectory(t, *self.at(t))
+
+    @classmethod
+    def from_vector(cls, z: np.ndarray, period: float, harmonics: int) -> FourierMotion:
+        z = np.asarray(z, dtype=float)
+        L = harmonics
+        return cls(period, z[:3], z[3 : 3 + 3 * L].reshape(3, L), z[3 + 3 * L :].reshape(3, L))
+
+    def vector(self) -> np.ndarray:
+        return np.concatenate([self.offset, self.a.ravel(), self.b.ravel()])
+
+
+@dataclass(frozen=True)
+class Excitation:
+    """The result of :func:`excite`.
+
+    Attributes:
+        motion: the optimised Fourier motion.
+        trajectory: one period of it, sampled.
+        condition_number: cond(W) of the optimised motion (unit-norm columns).
+        initial_condition_number: cond(W) of the starting motion.
+        iterations: SLSQP iterations.
+        min_conditioning: the smallest ``conditioning`` along the motion.
+        stroke: (3, 2) the piston displacement range of each leg along the motion (m).
+    """
+
+    motion: FourierMotion
+    trajectory: Trajectory
+    condition_number: float
+    initial_condition_number: float
+    iterations: int
+    min_conditioning: float
+    stroke: np.ndarray
+
+
+def _stroke(model: Model) -> np.ndarray:
+    if model.stroke is not None:
+        return np.array(model.stroke, dtype=float)
+    half = model.params["l0"] / 2
+    return np.array([[-half, half]] * len(LEGS))
+
+
+def excite(
+    model: Model,
+    *,
+    harmonics: int = 5,
+    period: float = 10.0,
+    samples: int = 201,
+    min_conditioning: float = 0.1,
+    max_acceleration: tuple[float, float] = (2.0, 10.0),
+    identical_legs: bool = False,
+    friction: bool = False,
+    seed: int = 0,
+    max_iterations: int = 100,
+) -> Excitation:
+    """Optimise an exciting Fourier motion for identifying ``model``'s base parameters.
+
+    Args:
+        model: the robot (geometry, stroke limits; its masses do not matter).
+        harmonics: L, the number of harmonics per coordinate.
+        period: T (s), the motion's period; the lowest harmonic is 1/T.
+        samples: samples per period at which the constraints and W are evaluated.
+        min_conditioning: the floor on ``conditioning`` (1 at best, 0 singular).
+        max_acceleration: the bound on |x''|, |y''| (m/s^2) and on |phi''| (rad/s^2).
+        identical_legs: optimise for the 9 shared base parameters instead of 19.
+        friction: include the friction columns in W.
+        seed: of the random starting coefficients.
+        max_iterations: SLSQP's limit.
+
+    Raises:
+        InputError: a bad option.
+        IdentificationError: no feasible starting motion (the central configuration itself
+            violates the constraints).
+    """
+    if not (isinstance(harmonics, int) and harmonics >= 1):
+        raise InputError(f"harmonics must be an integer >= 1, got {harmonics!r}")
+    if not (isinstance(samples, int) and samples >= 10):
+        raise InputError(f"samples must be an integer >= 10, got {samples!r}")
+    if not (period > 0 and math.isfinite(period)):
+        raise InputError(f"period must be a positive number of seconds, got {period!r}")
+    if not 0 <= min_conditioning < 1:
+        raise InputError(f"min_conditioning must be in [0, 1), got {min_conditioning!r}")
+    base = base_parameters(model, identical_legs)
+    columns = list(base.columns)
+    stroke = _stroke(model)
+    t = np.linspace(0.0, period, samples)
+    rho = platform_radius(model)
+    acc = np.array([max_acceleration[0], max_acceleration[0], max_acceleration[1]], dtype=float)
+    w = 2 * math.pi / period
+    # Scale of the coefficients (velocity amplitudes): a platform excursion of about rho / 10
+    # (m) and 0.2 rad at the lowest harmonic.
+    scale = np.concatenate(
+        [
+            [rho / 10, rho / 10, 0.2],
+            np.repeat([rho / 10 * w, rho / 10 * w, 0.2 * w], harmonics),
+            np.repeat([rho / 10 * w, rho / 10 * w, 0.2 * w], harmonics),
+        ]
+    )
+
+    def motion(u: np.ndarray) -> FourierMotion:
+        return FourierMotion.from_vector(u * scale, period, harmonics)
+
+    def regressor_rows(u: np.ndarray) -> np.ndarray:
+        q, qd, qdd = motion(u).at(t)
+        (Y,), _ = evaluate(model, "regressor", (q, qd, qdd))
+        Y = Y.reshape(samples, 3, -1)
+        if identical_legs:
+            Y = Y @ shared_matrix()
+        W = Y[..., columns]
+        if friction:
+            W = np.concatenate([W, friction_columns(model, q, qd)], axis=2)
+        return W.reshape(-1, W.shape[2])
+
+    def log_cond(u: np.ndarray) -> float:
+        W = regressor_rows(u)
+        if not np.isfinite(W).all():
+            return 80.0
+        norms = np.linalg.norm(W, axis=0)
+        if (norms == 0).any():
+            return 80.0
+        s = np.linalg.svd(W / norms, compute_uv=False)
+        return float(np.log(s[0] / s[-1])) if s[-1] > 0 else 80.0
+
+    def constraints(u: np.ndarray) -> np.ndarray:
+        q, _, qdd = motion(u).at(t)
+        (out,), codes = evaluate(model, "inverse_dynamics", (q, np.zeros_like(q), qdd))
+        names = _output_index(model)
+        cond = out[:, names["conditioning"]]
+        lam = out[:, [names[f"lambda21_{leg}"] for leg in LEGS]]
+        parts = [
+            np.where(codes == 0, cond - min_conditioning, -1.0),
+            (
+                np.where(codes[:, None] == 0, lam - stroke[:, 0], -1.0) / np.ptp(stroke, axis=1)
+            ).ravel(),
+            (
+                np.where(codes[:, None] == 0, stroke[:, 1] - lam, -1.0) / np.ptp(stroke, axis=1)
+            ).ravel(),
+            (1.0 - np.abs(qdd) / acc).ravel(),
+        ]
+        return np.nan_to_num(np.concatenate(parts), nan=-1.0)
+
+    rng = np.random.default_rng(seed)
+    start = np.concatenate([np.zeros(3), rng.uniform(-1.0, 1.0, 6 * harmonics) / harmonics])
+    # The optimiser sees the constraints with a margin, so that an iterate a hair outside
+    # them (SLSQP's are, before it converges) still keeps the true ones.
+    margin = 1e-3
+    for _ in range(30):  # shrink the random start until it is feasible
+        if constraints(start).min() >= margin:
+            break
+        start[3:] *= 0.5
+    else:
+        raise IdentificationError(
+            "excite: the central configuration itself violates the constraints (stroke, "
+            "conditioning); relax them"
+        )
+    initial = math.exp(log_cond(start))
+    result = scipy.optimize.minimize(
+        log_cond,
+        start,
+        method="SLSQP",
+        constraints=[{"type": "ineq", "fun": lambda u: constraints(u) - margin}],
+        options={"maxiter": max_iterations, "ftol": 1e-6},
+    )
+    best = result.x if constraints(result.x).min() >= 0 else start
+    if log_cond(best) > log_cond(start):
+        best = start
+    found = motion(best)
+    traj = found.trajectory(samples)
+    (out,), _ = evaluate(model, "inverse_dynamics", (traj.q, traj.qd, traj.qdd))
+    names = _output_index(model)
+    lam = out[:, [names[f"lambda21_{leg}"] for leg in LEGS]]
+    return Excitation(
+        motion=found,
+        trajectory=traj,
+        condition_number=math.exp(log_cond(best)),
+        initial_condition_number=initial,
+        iterations=int(result.nit),
+        min_conditioning=float(out[:, names["conditioning"]].min()),
+        stroke=np.stack([lam.min(axis=0), lam.max(axis=0)], axis=1),
+    )
+
+
+def _output_index(model: Model) -> dict[str, int]:
+    info = manifest.load(model.actuation, model.generated).function("inverse_dynamics")
+    return {name: k for k, name in enumerate(info.outputs[0].names)}
