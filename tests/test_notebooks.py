@@ -18,7 +18,9 @@ def _ids(path: Path) -> str:
 
 
 def test_the_notebooks_are_there() -> None:
-    assert {"derivation.ipynb", "simulation.ipynb"} <= {p.name for p in NOTEBOOKS}
+    assert {"derivation.ipynb", "simulation.ipynb", "identification.ipynb"} <= {
+        p.name for p in NOTEBOOKS
+    }
 
 
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=_ids)

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 import scipy.optimize
@@ -28,7 +29,7 @@ from rpr3gen import manifest
 from rpr3gen.backends import evaluate
 from rpr3gen.control import platform_radius
 from rpr3gen.errors import IdentificationError, InputError
-from rpr3gen.identification import base_parameters, friction_columns, shared_matrix
+from rpr3gen.identification import base_parameters, one_blas_thread, shared_matrix
 from rpr3gen.model import LEGS, Model
 from rpr3gen.trajectory import Trajectory
 
@@ -100,6 +101,7 @@ def _stroke(model: Model) -> np.ndarray:
     return np.array([[-half, half]] * len(LEGS))
 
 
+@one_blas_thread
 def excite(
     model: Model,
     *,
@@ -160,41 +162,54 @@ def excite(
     def motion(u: np.ndarray) -> FourierMotion:
         return FourierMotion.from_vector(u * scale, period, harmonics)
 
-    def regressor_rows(u: np.ndarray) -> np.ndarray:
-        q, qd, qdd = motion(u).at(t)
+    names = _output_index(model)
+    rate_family = "omega10" if model.actuation == "revolute" else "v21"
+    conditioning_column = names["conditioning"]
+    stroke_columns = [names[f"lambda21_{leg}"] for leg in LEGS]
+    rate_columns = [names[f"{rate_family}_{leg}"] for leg in LEGS]
+
+    @lru_cache(maxsize=64)  # SLSQP asks for f and the constraints at the same points
+    def _at(key: bytes) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        q, qd, qdd = motion(np.frombuffer(key)).at(t)
+        (out,), codes = evaluate(model, "inverse_dynamics", (q, qd, qdd))
         (Y,), _ = evaluate(model, "regressor", (q, qd, qdd))
         Y = Y.reshape(samples, 3, -1)
         if identical_legs:
             Y = Y @ shared_matrix()
         W = Y[..., columns]
-        if friction:
-            W = np.concatenate([W, friction_columns(model, q, qd)], axis=2)
-        return W.reshape(-1, W.shape[2])
+        if friction:  # the actuator rates are the inverse dynamics' omega10 or v21
+            rate = out[:, rate_columns]
+            extra = np.zeros((samples, 3, 6))
+            for i in range(3):
+                extra[:, i, i] = rate[:, i]
+                extra[:, i, 3 + i] = np.sign(rate[:, i])
+            W = np.concatenate([W, extra], axis=2)
+        return W.reshape(-1, W.shape[2]), out, codes, qdd
+
+    def at(u: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        return _at(np.asarray(u, dtype=float).tobytes())
 
     def log_cond(u: np.ndarray) -> float:
-        W = regressor_rows(u)
+        W = at(u)[0]
         if not np.isfinite(W).all():
             return 80.0
         norms = np.linalg.norm(W, axis=0)
         if (norms == 0).any():
             return 80.0
-        s = np.linalg.svd(W / norms, compute_uv=False)
+        # cond(W) = cond(R) of W = QR: the small R's singular values cost far less.
+        s = np.linalg.svd(np.linalg.qr(W / norms, mode="r"), compute_uv=False)
         return float(np.log(s[0] / s[-1])) if s[-1] > 0 else 80.0
 
     def constraints(u: np.ndarray) -> np.ndarray:
-        q, _, qdd = motion(u).at(t)
-        (out,), codes = evaluate(model, "inverse_dynamics", (q, np.zeros_like(q), qdd))
-        names = _output_index(model)
-        cond = out[:, names["conditioning"]]
-        lam = out[:, [names[f"lambda21_{leg}"] for leg in LEGS]]
+        _, out, codes, qdd = at(u)
+        cond = out[:, conditioning_column]
+        lam = out[:, stroke_columns]
+        ok = codes[:, None] == 0
+        width = np.ptp(stroke, axis=1)
         parts = [
             np.where(codes == 0, cond - min_conditioning, -1.0),
-            (
-                np.where(codes[:, None] == 0, lam - stroke[:, 0], -1.0) / np.ptp(stroke, axis=1)
-            ).ravel(),
-            (
-                np.where(codes[:, None] == 0, stroke[:, 1] - lam, -1.0) / np.ptp(stroke, axis=1)
-            ).ravel(),
+            (np.where(ok, lam - stroke[:, 0], -1.0) / width).ravel(),
+            (np.where(ok, stroke[:, 1] - lam, -1.0) / width).ravel(),
             (1.0 - np.abs(qdd) / acc).ravel(),
         ]
         return np.nan_to_num(np.concatenate(parts), nan=-1.0)
@@ -227,7 +242,6 @@ def excite(
     found = motion(best)
     traj = found.trajectory(samples)
     (out,), _ = evaluate(model, "inverse_dynamics", (traj.q, traj.qd, traj.qdd))
-    names = _output_index(model)
     lam = out[:, [names[f"lambda21_{leg}"] for leg in LEGS]]
     return Excitation(
         motion=found,

@@ -18,13 +18,15 @@ actuations). :func:`identify` estimates them by weighted least squares.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from functools import lru_cache
+from functools import lru_cache, wraps
+from typing import ParamSpec, TypeVar
 
 import numpy as np
 import scipy.linalg
 from numpy.typing import ArrayLike
+from threadpoolctl import threadpool_limits
 
 from rpr3gen import manifest
 from rpr3gen.backends import evaluate, samples
@@ -80,6 +82,23 @@ def _preference(identical_legs: bool) -> tuple[str, ...]:
         order += [f"mcx_1{leg}", f"mcy_1{leg}", f"Jzz_1{leg}", f"mcx_2{leg}", f"mcy_2{leg}"]
         order += [f"Jzz_2{leg}", f"m_2{leg}", f"m_1{leg}"]
     return tuple(order)
+
+
+_P = ParamSpec("_P")
+_R = TypeVar("_R")
+
+
+def one_blas_thread(function: Callable[_P, _R]) -> Callable[_P, _R]:
+    """Run ``function`` with one BLAS thread: its factorisations are small (a few hundred rows
+    by a few dozen columns), so threads only fight over the cores (ten times slower on a
+    loaded machine) and make the last bits of the results depend on their number."""
+
+    @wraps(function)
+    def wrapper(*args: _P.args, **kwargs: _P.kwargs) -> _R:
+        with threadpool_limits(limits=1, user_api="blas"):
+            return function(*args, **kwargs)
+
+    return wrapper
 
 
 def parameter_names(identical_legs: bool = False) -> tuple[str, ...]:
@@ -220,6 +239,7 @@ def _excitation_samples(model: Model, count: int) -> tuple[np.ndarray, ...]:
 
 
 @lru_cache(maxsize=32)
+@one_blas_thread
 def _base_parameters(model: Model, identical_legs: bool) -> BaseParameters:
     names = parameter_names(identical_legs)
     q, qd, qdd = _excitation_samples(model, 120)
@@ -394,6 +414,7 @@ def _weak_parameters(names: Sequence[str], s: np.ndarray, vt: np.ndarray, limit:
     return ", ".join(n for n in names if n in weak)
 
 
+@one_blas_thread
 def identify(
     model: Model,
     q: ArrayLike,
