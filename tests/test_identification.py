@@ -426,3 +426,31 @@ def test_cli_excite_writes_a_trajectory(tmp_path: Path, capsys) -> None:
     assert "->" in text
     traj = rpr3gen.read_trajectory_csv(out)
     assert len(traj) == 61
+
+
+def test_the_example_writes_data_that_identify_reads(tmp_path: Path, capsys) -> None:
+    """examples/identification: the script's data recover its true platform mass."""
+    import runpy
+    import sys
+
+    script = Path(__file__).resolve().parent.parent / "examples/identification"
+    out = tmp_path / "measured.csv"
+    argv = sys.argv
+    sys.argv = ["simulate_measurements.py", "--out", str(out)]
+    try:
+        namespace = runpy.run_path(str(script / "simulate_measurements.py"), run_name="__main__")
+    finally:
+        sys.argv = argv
+    model_file = Path(rpr3gen.load_model().source)
+    args = ["identify", "--model", str(model_file), "--data", str(out), "--friction"]
+    assert main([*args, "--smoothing", "2e-5"]) == 0
+    text = capsys.readouterr().out
+    true = dataclasses.replace(
+        rpr3gen.load_model(), params=dict(rpr3gen.load_model().params) | namespace["TRUE_PARAMS"]
+    )
+    base = rpr3gen.base_parameters(true)
+    want = dict(zip(base.names, base.matrix @ rpr3gen.inertial_parameters(true), strict=True))
+    row = next(x.split() for x in text.splitlines() if x.split()[:1] == ["m_3"])
+    estimate, std = float(row[1]), float(row[2])
+    assert abs(estimate - want["m_3"]) < 4 * std
+    assert std < 0.01 * want["m_3"]

@@ -121,7 +121,7 @@ def _toml_value(value: object) -> str:
 
 def fit_toml(fit, model: Model, data: str) -> str:
     """The estimates of ``fit`` as a TOML document."""
-    base_values = fit.base.matrix @ _model_pi(model, fit.identical_legs)
+    base_values = _model_base(fit)
     lines = [
         f"# rpr3gen identify: base parameters of {json.dumps(model.name)} from {data}",
         "",
@@ -153,10 +153,14 @@ def fit_toml(fit, model: Model, data: str) -> str:
     return "\n".join(lines) + "\n"
 
 
-def _model_pi(model: Model, identical_legs: bool) -> np.ndarray:
+def _model_base(fit) -> np.ndarray:
+    """The model file's base parameters, round-off (e.g. J1 + J2 - l2^2 m2 of the paper's
+    robot, exactly 0) shown as 0."""
     from rpr3gen.identification import inertial_parameters
 
-    return inertial_parameters(model, identical_legs)
+    values = fit.base.matrix @ inertial_parameters(fit.model, fit.identical_legs)
+    values[np.abs(values) < 1e-12 * np.abs(values).max()] = 0.0
+    return values
 
 
 def cmd_identify(args: argparse.Namespace) -> int:
@@ -188,7 +192,7 @@ def cmd_identify(args: argparse.Namespace) -> int:
             f.write(fit_toml(fit, model, args.data))
     unit = UNIT[model.actuation]
     legs = "identical legs" if args.identical_legs else "per leg"
-    base_values = fit.base.matrix @ _model_pi(model, args.identical_legs)
+    base_values = _model_base(fit)
     expressions = fit.base.expressions(4)
     per = ", ".join(
         f"{leg} {r:.4g}" for leg, r in zip(LEGS, fit.residual_rms_per_actuator, strict=True)
