@@ -7,7 +7,8 @@
 >>> out["m10_A"].shape
 (301,)
 
-The runtime imports numpy (matplotlib for figures, scipy for trajectories of positions only);
+The runtime imports numpy (matplotlib for figures, scipy for trajectories of positions only,
+pyarrow and Dask for design studies: :func:`workspace`, :func:`sweep`);
 regeneration lives in the package ``rpr3gen_derive`` (folder ``derive/``) and writes
 ``rpr3gen_generated`` (folder ``generated/``).
 """
@@ -27,7 +28,9 @@ from rpr3gen.control import (
     platform_velocity,
     task_space_dynamics,
 )
+from rpr3gen.design import WorkspaceMap, sweep, workspace, write_workspace
 from rpr3gen.errors import (
+    GridError,
     InputError,
     InputTypeError,
     ModelError,
@@ -49,6 +52,7 @@ __all__ = [
     "BACKENDS",
     "OUTPUT_NAMES",
     "PARAM_NAMES",
+    "GridError",
     "InputError",
     "InputTypeError",
     "Model",
@@ -59,6 +63,7 @@ __all__ = [
     "Trajectory",
     "TrajectoryError",
     "TrajectoryWarning",
+    "WorkspaceMap",
     "__version__",
     "actuator_coordinates",
     "actuator_efforts",
@@ -74,5 +79,8 @@ __all__ = [
     "platform_radius",
     "platform_velocity",
     "read_trajectory_csv",
+    "sweep",
     "task_space_dynamics",
+    "workspace",
+    "write_workspace",
 ]
