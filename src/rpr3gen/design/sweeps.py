@@ -388,6 +388,9 @@ class _Client:
             threads_per_worker=1,
             processes=True,
             dashboard_address=None,
+            # No dashboard, and its health routes on a free port, not on 8787: that one may be
+            # another cluster's (Dask warns, then takes another).
+            scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
             silence_logs=logging.ERROR,
         )
         self.client = Client(self.cluster)
@@ -408,8 +411,19 @@ class _ProgressBar:
         if wanted and sys.stderr.isatty():
             from tqdm import tqdm
 
-            self.bar = tqdm(total=total, initial=initial, unit="design", file=sys.stderr,
-                            leave=False, dynamic_ncols=True)  # fmt: skip
+            try:  # a terminal that reports no size (serial consoles, some CI) gets 80 x 24
+                size = os.get_terminal_size(sys.stderr.fileno())
+            except OSError:
+                size = os.terminal_size((0, 0))
+            self.bar = tqdm(
+                total=total,
+                initial=initial,
+                unit="design",
+                file=sys.stderr,
+                leave=False,
+                ncols=size.columns or 80,
+                nrows=size.lines or 24,
+            )
 
     def __enter__(self) -> _ProgressBar:
         return self
