@@ -63,13 +63,21 @@ def run_sweep(mode: str, designs: int, area: int, scheduler: str | None) -> dict
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp) / "sweep.parquet"
         peaks: list[int] = []
-        original = sweeps._Client.__exit__
+        startup: list[float] = []
+        enter, leave = sweeps._Client.__enter__, sweeps._Client.__exit__
+
+        def timed_enter(self: Any) -> Any:  # importing distributed, starting the cluster
+            begin = time.perf_counter()
+            client = enter(self)
+            startup.append(time.perf_counter() - begin)
+            return client
 
         def exit_with_peaks(self: Any, *exc: object) -> None:  # read the workers' peaks first
             if self.client is not None:
                 peaks.extend(_worker_rss(client=self.client))
-            original(self, *exc)
+            leave(self, *exc)
 
+        sweeps._Client.__enter__ = timed_enter  # type: ignore[method-assign]
         sweeps._Client.__exit__ = exit_with_peaks  # type: ignore[method-assign]
         start = time.perf_counter()
         table = rpr3gen.sweep(None, grid, out=out, scheduler=scheduler, workers=workers,
@@ -81,6 +89,7 @@ def run_sweep(mode: str, designs: int, area: int, scheduler: str | None) -> dict
         "designs": table.num_rows,
         "area": area,
         "seconds": seconds,
+        "startup": sum(startup),
         "client_rss_kib": _rss_kib(),
         "worker_rss_kib": peaks,
         "parquet_bytes": size,
@@ -155,11 +164,15 @@ class _Cluster:
                 stderr=subprocess.DEVNULL,
             )
         ]
+        # As README's "On a cluster" says: workers that keep their freed memory (Dask's nanny
+        # would make them return it beyond 64 KiB, and every NumPy temporary page-faults).
+        env = {**os.environ, "MALLOC_TRIM_THRESHOLD_": str(1 << 28),
+               "MALLOC_MMAP_THRESHOLD_": str(1 << 25)}  # fmt: skip
         for k in range(2):
             self.procs.append(subprocess.Popen(
                 [*dask, "worker", self.address, "--nworkers", "1", "--nthreads", "1",
                  "--no-dashboard", "--name", f"bench-{k}", "--local-directory", self.tmp.name],
-                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))  # fmt: skip
+                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env))  # fmt: skip
         with Client(self.address, timeout="120s") as client:
             client.wait_for_workers(2, timeout=120)
         return self.address
@@ -220,8 +233,8 @@ def main() -> int:
         "scheduler": "`--scheduler`: dask scheduler + 2 dask workers on localhost",
     }
     machine = platform.processor() or platform.machine()
-    header = ["run", "designs", "area", "time", "designs/s", "vs plain loop", "client RSS (MiB)",
-              "workers' RSS (MiB)"]  # fmt: skip
+    header = ["run", "designs", "area", "time (start)", "designs/s", "after start",
+              "vs plain loop", "client RSS (MiB)", "workers' RSS (MiB)"]  # fmt: skip
     lines = [
         "# Sweep throughput and memory",
         "",
@@ -233,22 +246,25 @@ def main() -> int:
         "Grid: `geometry.l0` x `mass.m3` of the paper robot, both paper trajectories (301 samples "
         f"each), workspace area on {AREA} x {AREA} points, chunks of 64 designs. Each run is a "
         "fresh interpreter; the time includes starting and stopping the local cluster (not the "
-        "external one), and writing the Parquet file. RSS: peak resident memory (ru_maxrss).",
+        "external one), and writing the Parquet file; (start) is the part spent importing Dask "
+        "and connecting to or starting the cluster, and *after start* the rate without it. RSS: "
+        "peak resident memory (ru_maxrss).",
         "",
         "| " + " | ".join(header) + " |",
-        "|---|---:|---|---:|---:|---:|---:|---|",
+        "|---|---:|---|---:|---:|---:|---:|---:|---|",
     ]
     for run in [*runs, large]:
         rate = run["designs"] / run["seconds"]
         area = f"{run['area']}²" if run["area"] else "none"
+        steady = run["designs"] / (run["seconds"] - run["startup"])
         lines.append(
-            f"| {names[run['mode']]} | {run['designs']:,} | {area} | {run['seconds']:.1f} s | "
-            f"{rate:,.0f} | {rate / loop_rate:.1f}x | {_mib(run['client_rss_kib'])} | "
-            f"{_mib(run['worker_rss_kib'])} |"
+            f"| {names[run['mode']]} | {run['designs']:,} | {area} | {run['seconds']:.1f} s "
+            f"({run['startup']:.1f} s) | {rate:,.0f} | {steady:,.0f} | {rate / loop_rate:.1f}x | "
+            f"{_mib(run['client_rss_kib'])} | {_mib(run['worker_rss_kib'])} |"
         )
     lines += [
         "| plain loop over `rpr3gen.inverse_dynamics`, one design at a time | "
-        f"{loop['designs']:,} | none | {loop['seconds']:.1f} s | {loop_rate:,.0f} | 1x | "
+        f"{loop['designs']:,} | none | {loop['seconds']:.1f} s | {loop_rate:,.0f} | - | 1x | "
         f"{_mib(loop['client_rss_kib'])} | - |",
         "",
         "The plain loop does the trajectory part only (a model per design, one "

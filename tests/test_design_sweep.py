@@ -339,3 +339,23 @@ def test_the_command_summary_and_a_progress_bar_on_a_terminal(tmp_path: Path) ->
     assert b"9/9" in seen
     assert b"design" in seen
     assert pq.read_table(out).num_rows == 9
+
+
+def test_the_bytes_depend_on_the_rows_alone(tmp_path: Path) -> None:
+    """Chunks of another size (so other part files) give the same file."""
+    files = [tmp_path / "a.parquet", tmp_path / "b.parquet"]
+    for path, chunk_size in zip(files, (2, 5), strict=True):
+        rpr3gen.sweep(None, GRID, out=path, workers=0, **{**OPTIONS, "chunk_size": chunk_size})
+    assert files[0].read_bytes() == files[1].read_bytes()
+
+
+def test_a_failed_task_is_one_line() -> None:
+    class Lost:
+        def result(self) -> Any:
+            raise RuntimeError("worker tcp://10.0.0.7:4321 died")
+
+    with pytest.raises(rpr3gen.Rpr3genError) as caught:
+        sweeps._result(Lost())
+    assert str(caught.value) == (
+        "a sweep task failed on the Dask cluster: RuntimeError: worker tcp://10.0.0.7:4321 died"
+    )

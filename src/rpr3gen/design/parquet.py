@@ -8,7 +8,7 @@ schema, so the bytes depend on the values alone: no time, host or path is stored
 from __future__ import annotations
 
 import os
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -17,7 +17,7 @@ import pyarrow.parquet as pq
 
 from rpr3gen.atomic import atomic_write
 
-__all__ = ["WRITE_OPTIONS", "read_table", "to_table", "write_table"]
+__all__ = ["WRITE_OPTIONS", "read_table", "to_table", "write_table", "write_tables"]
 
 WRITE_OPTIONS: Mapping[str, Any] = {
     "compression": "zstd",
@@ -46,6 +46,36 @@ def write_table(path: str | os.PathLike[str], table: pa.Table) -> None:
     """Write ``table`` as Parquet at ``path``, atomically, with :data:`WRITE_OPTIONS`."""
     with atomic_write(path, "wb") as f:
         pq.write_table(table.replace_schema_metadata(None), f, **WRITE_OPTIONS)
+
+
+def write_tables(path: str | os.PathLike[str], parts: Iterable[str | os.PathLike[str]]) -> None:
+    """Write the Parquet files ``parts``, one after the other, as one file at ``path``,
+    atomically, with :data:`WRITE_OPTIONS`, holding at most one row group in memory.
+
+    The row groups have ``row_group_size`` rows whatever the parts' sizes, so the bytes depend
+    on the rows alone.
+    """
+    options = dict(WRITE_OPTIONS)
+    rows = options.pop("row_group_size")
+    with atomic_write(path, "wb") as f:
+        writer: pq.ParquetWriter | None = None
+        pending: list[pa.Table] = []
+        count = 0
+        for part in parts:
+            table = read_table(part)
+            if writer is None:
+                writer = pq.ParquetWriter(f, table.schema, **options)
+            pending.append(table.cast(writer.schema))
+            count += table.num_rows
+            while count >= rows:
+                whole = pa.concat_tables(pending)
+                writer.write_table(whole.slice(0, rows).combine_chunks(), row_group_size=rows)
+                pending, count = [whole.slice(rows)], count - rows
+        if writer is None:
+            raise ValueError("write_tables: no parts")
+        if count:
+            writer.write_table(pa.concat_tables(pending).combine_chunks(), row_group_size=rows)
+        writer.close()
 
 
 def read_table(path: str | os.PathLike[str]) -> pa.Table:

@@ -60,6 +60,12 @@ DEFAULT_AREA_RESOLUTION = 48
 DEFAULT_TRAJECTORIES: tuple[str, ...] = tuple(PAPER_TRAJECTORIES)
 """The paper's two motions."""
 
+#: Dask's setting that makes its worker processes return freed memory to the system beyond 64 KiB
+#: (``MALLOC_TRIM_THRESHOLD_``). With it, glibc maps and unmaps every large NumPy temporary of
+#: the generated code, and the page faults halve a sweep's speed; the local cluster's workers
+#: run without it (glibc's default: freed memory is reused). See README, "On a cluster".
+MALLOC_TRIM = "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_"
+
 _PLAN_FILE = "sweep.json"
 _FORMAT = 1
 
@@ -139,12 +145,14 @@ def sweep(
     done = _done_chunks(plan, folder)
     todo = [i for i in range(plan.chunks) if i not in done]
     initial = sum(len(plan.chunk(i)) for i in done)
-    run_chunks(plan, todo, keep, scheduler, workers, progress, initial=initial)
-    table = _joined(parquet.read_table(folder / _part_name(i)) for i in range(plan.chunks))
+    try:
+        run_chunks(plan, todo, keep, scheduler, workers, progress, initial=initial)
+    except Rpr3genError as exc:
+        raise Rpr3genError(f"{exc}; the chunks done are in {folder}: rerun with --resume") from exc
     target.parent.mkdir(parents=True, exist_ok=True)
-    parquet.write_table(target, table)
+    parquet.write_tables(target, (folder / _part_name(i) for i in range(plan.chunks)))
     shutil.rmtree(folder)
-    return table
+    return parquet.read_table(target)
 
 
 def make_plan(
@@ -356,12 +364,25 @@ def run_chunks(
             ]
             try:
                 for future in as_completed(futures):
-                    index, columns = future.result()
+                    index, columns = _result(future)
                     done(index, columns)
                     bar.update(len(plan.chunk(index)))
                     future.release()
             finally:
                 client.cancel(futures)
+
+
+def _result(future: Any) -> tuple[int, Columns]:
+    """A task's result; its failure (a lost worker, rpr3gen missing there...) as one line."""
+    try:
+        result: tuple[int, Columns] = future.result()
+    except Rpr3genError:
+        raise
+    except Exception as exc:
+        raise Rpr3genError(
+            f"a sweep task failed on the Dask cluster: {type(exc).__name__}: {exc}"
+        ) from exc
+    return result
 
 
 class _Client:
@@ -374,6 +395,7 @@ class _Client:
         self.client: Any = None
 
     def __enter__(self) -> Any:
+        import dask
         from distributed import Client, LocalCluster
 
         if self.address is not None:
@@ -383,16 +405,17 @@ class _Client:
                 raise Rpr3genError(f"scheduler {self.address}: cannot connect: {exc}") from None
             return self.client
         n = self.workers or len(os.sched_getaffinity(0))
-        self.cluster = LocalCluster(
-            n_workers=n,
-            threads_per_worker=1,
-            processes=True,
-            dashboard_address=None,
-            # No dashboard, and its health routes on a free port, not on 8787: that one may be
-            # another cluster's (Dask warns, then takes another).
-            scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
-            silence_logs=logging.ERROR,
-        )
+        with dask.config.set({MALLOC_TRIM: None}):
+            self.cluster = LocalCluster(
+                n_workers=n,
+                threads_per_worker=1,
+                processes=True,
+                dashboard_address=None,
+                # No dashboard, and its health routes on a free port, not on 8787: that one may
+                # be another cluster's (Dask warns, then takes another).
+                scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
+                silence_logs=logging.ERROR,
+            )
         self.client = Client(self.cluster)
         return self.client
 
