@@ -56,7 +56,7 @@ def _worker_rss(scheduler: str | None = None, client: Any = None) -> list[int]:
 def run_sweep(mode: str, designs: int, area: int, scheduler: str | None) -> dict[str, Any]:
     """One sweep in this (fresh) interpreter; its time and memory peaks."""
     import rpr3gen
-    from rpr3gen.design import sweeps
+    from rpr3gen.design import cluster
 
     grid = _grid(designs)
     workers = {"inprocess": 0, "local1": 1, "local": None, "scheduler": None}[mode]
@@ -64,7 +64,7 @@ def run_sweep(mode: str, designs: int, area: int, scheduler: str | None) -> dict
         out = Path(tmp) / "sweep.parquet"
         peaks: list[int] = []
         startup: list[float] = []
-        enter, leave = sweeps._Client.__enter__, sweeps._Client.__exit__
+        enter, leave = cluster.ClusterClient.__enter__, cluster.ClusterClient.__exit__
 
         def timed_enter(self: Any) -> Any:  # importing distributed, starting the cluster
             begin = time.perf_counter()
@@ -77,8 +77,8 @@ def run_sweep(mode: str, designs: int, area: int, scheduler: str | None) -> dict
                 peaks.extend(_worker_rss(client=self.client))
             leave(self, *exc)
 
-        sweeps._Client.__enter__ = timed_enter  # type: ignore[method-assign]
-        sweeps._Client.__exit__ = exit_with_peaks  # type: ignore[method-assign]
+        cluster.ClusterClient.__enter__ = timed_enter  # type: ignore[method-assign]
+        cluster.ClusterClient.__exit__ = exit_with_peaks  # type: ignore[method-assign]
         start = time.perf_counter()
         table = rpr3gen.sweep(None, grid, out=out, scheduler=scheduler, workers=workers,
                               area_resolution=area)  # fmt: skip

@@ -23,7 +23,7 @@ import pytest
 
 import rpr3gen
 from rpr3gen.cli import main
-from rpr3gen.design import sweeps
+from rpr3gen.design import cluster, sweeps
 from rpr3gen.design.grid import read_grid
 from rpr3gen.design.metrics import RESULT_COLUMNS, evaluate_chunk
 from rpr3gen.design.stacked import evaluate_stacked, param_rows
@@ -355,7 +355,7 @@ def test_a_failed_task_is_one_line() -> None:
             raise RuntimeError("worker tcp://10.0.0.7:4321 died")
 
     with pytest.raises(rpr3gen.Rpr3genError) as caught:
-        sweeps._result(Lost())
+        cluster.task_result(Lost())
     assert str(caught.value) == (
         "a sweep task failed on the Dask cluster: RuntimeError: worker tcp://10.0.0.7:4321 died"
     )

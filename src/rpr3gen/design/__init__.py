@@ -3,7 +3,8 @@
 - :func:`workspace` maps one design at a fixed platform angle (:mod:`.maps`), and
   :func:`write_workspace` writes the map as Parquet and four figures (:mod:`.outputs`).
 - :func:`sweep` evaluates every design of a grid (:mod:`.grid`) over trajectories
-  (:mod:`.metrics`), in chunks on Dask (:mod:`.sweeps`), as Parquet (:mod:`.parquet`).
+  (:mod:`.metrics`), in chunks (:mod:`.sweeps`) on Dask (:mod:`.cluster`), as Parquet
+  (:mod:`.parquet`).
 
 Both evaluate the generated NumPy code with one parameter vector per sample
 (:mod:`.stacked`), and count a pose reachable as :mod:`.reach` says.

@@ -3,27 +3,27 @@
 The designs are cut into chunks of ``chunk_size`` in the grid's order; each chunk is one task
 (:func:`rpr3gen.design.metrics.evaluate_chunk`). Tasks run on a Dask cluster (a local one on
 this machine's cores by default, or the scheduler at ``scheduler``) or, with ``workers=0``, in
-this process. The client writes each finished chunk as ``OUT.parts/chunk-NNNNNN.parquet``
-(atomically) as it arrives, so an interrupted sweep resumes (``resume=True``) from the chunks
-done; at the end the chunks are joined, in order, into ``OUT`` (atomically) and the parts folder
-is removed. The chunks, and so the output's bytes, do not depend on the number of workers.
+this process (:mod:`rpr3gen.design.cluster`). The client writes each finished chunk as
+``OUT.parts/chunk-NNNNNN.parquet`` (atomically) as it arrives, so an interrupted sweep resumes
+(``resume=True``) from the chunks done; at the end the chunks are joined, in order, into ``OUT``
+(atomically) and the parts folder is removed. The chunks, and so the output's bytes, do not
+depend on the number of workers.
 """
 
 from __future__ import annotations
 
 import hashlib
 import json
-import logging
 import os
 import shutil
-import sys
-from collections.abc import Callable, Iterable, Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from rpr3gen import manifest
+from rpr3gen.design.cluster import run_chunks
 from rpr3gen.design.grid import read_grid
 from rpr3gen.design.metrics import SweepPlan, evaluate_chunk
 from rpr3gen.errors import (
@@ -59,12 +59,6 @@ DEFAULT_AREA_RESOLUTION = 48
 
 DEFAULT_TRAJECTORIES: tuple[str, ...] = tuple(PAPER_TRAJECTORIES)
 """The paper's two motions."""
-
-#: Dask's setting that makes its worker processes return freed memory to the system beyond 64 KiB
-#: (``MALLOC_TRIM_THRESHOLD_``). With it, glibc maps and unmaps every large NumPy temporary of
-#: the generated code, and the page faults halve a sweep's speed; the local cluster's workers
-#: run without it (glibc's default: freed memory is reused). See README, "On a cluster".
-MALLOC_TRIM = "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_"
 
 _PLAN_FILE = "sweep.json"
 _FORMAT = 1
@@ -131,7 +125,8 @@ def sweep(
         if resume:
             raise InputError("resume: needs out, the file whose chunks are resumed")
         parts: dict[int, Columns] = {}
-        run_chunks(plan, range(plan.chunks), parts.__setitem__, scheduler, workers, progress)
+        run_chunks(plan, range(plan.chunks), evaluate_chunk, parts.__setitem__, scheduler, workers,
+                   progress)  # fmt: skip
         return _joined(_table(parts[i]) for i in range(plan.chunks))
     from rpr3gen.design import parquet
 
@@ -146,7 +141,7 @@ def sweep(
     todo = [i for i in range(plan.chunks) if i not in done]
     initial = sum(len(plan.chunk(i)) for i in done)
     try:
-        run_chunks(plan, todo, keep, scheduler, workers, progress, initial=initial)
+        run_chunks(plan, todo, evaluate_chunk, keep, scheduler, workers, progress, initial=initial)
     except Rpr3genError as exc:
         raise Rpr3genError(f"{exc}; the chunks done are in {folder}: rerun with --resume") from exc
     target.parent.mkdir(parents=True, exist_ok=True)
@@ -328,133 +323,3 @@ def _joined(tables: Iterable[Any]) -> Any:
     import pyarrow as pa
 
     return pa.concat_tables(list(tables)).combine_chunks()
-
-
-def run_chunks(
-    plan: SweepPlan,
-    chunks: Iterable[int],
-    done: Callable[[int, Columns], None],
-    scheduler: str | None,
-    workers: int | None,
-    progress: bool,
-    initial: int = 0,
-) -> None:
-    """Evaluate ``chunks`` of ``plan``, calling ``done(index, columns)`` for each as it finishes.
-
-    In this process when ``workers == 0``; else on the Dask scheduler at ``scheduler``, or on a
-    local cluster of ``workers`` processes (None: one per core) started and stopped here.
-    """
-    todo = list(chunks)
-    with _ProgressBar(len(plan.grid), initial, progress) as bar:
-        if workers == 0 and scheduler is None:
-            for index in todo:
-                done(*evaluate_chunk(plan, index))
-                bar.update(len(plan.chunk(index)))
-            return
-        if not todo:
-            return
-        with _Client(scheduler, workers) as client:
-            from distributed import as_completed
-
-            shared = client.scatter(plan, broadcast=True, hash=False)
-            key = identity(plan)[:16]
-            futures = [
-                client.submit(evaluate_chunk, shared, index, key=f"rpr3gen-sweep-{key}-{index}")
-                for index in todo
-            ]
-            try:
-                for future in as_completed(futures):
-                    index, columns = _result(future)
-                    done(index, columns)
-                    bar.update(len(plan.chunk(index)))
-                    future.release()
-            finally:
-                client.cancel(futures)
-
-
-def _result(future: Any) -> tuple[int, Columns]:
-    """A task's result; its failure (a lost worker, rpr3gen missing there...) as one line."""
-    try:
-        result: tuple[int, Columns] = future.result()
-    except Rpr3genError:
-        raise
-    except Exception as exc:
-        raise Rpr3genError(
-            f"a sweep task failed on the Dask cluster: {type(exc).__name__}: {exc}"
-        ) from exc
-    return result
-
-
-class _Client:
-    """A Dask client of the scheduler at ``address``, or of a local cluster made for the run."""
-
-    def __init__(self, address: str | None, workers: int | None) -> None:
-        self.address = address
-        self.workers = workers
-        self.cluster: Any = None
-        self.client: Any = None
-
-    def __enter__(self) -> Any:
-        import dask
-        from distributed import Client, LocalCluster
-
-        if self.address is not None:
-            try:
-                self.client = Client(self.address, timeout="30s")
-            except (OSError, TimeoutError, ValueError) as exc:
-                raise Rpr3genError(f"scheduler {self.address}: cannot connect: {exc}") from None
-            return self.client
-        n = self.workers or len(os.sched_getaffinity(0))
-        with dask.config.set({MALLOC_TRIM: None}):
-            self.cluster = LocalCluster(
-                n_workers=n,
-                threads_per_worker=1,
-                processes=True,
-                dashboard_address=None,
-                # No dashboard, and its health routes on a free port, not on 8787: that one may
-                # be another cluster's (Dask warns, then takes another).
-                scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
-                silence_logs=logging.ERROR,
-            )
-        self.client = Client(self.cluster)
-        return self.client
-
-    def __exit__(self, *exc: object) -> None:
-        if self.client is not None:
-            self.client.close()
-        if self.cluster is not None:
-            self.cluster.close()
-
-
-class _ProgressBar:
-    """A tqdm bar of designs on stderr, when asked for and stderr is a terminal."""
-
-    def __init__(self, total: int, initial: int, wanted: bool) -> None:
-        self.bar: Any = None
-        if wanted and sys.stderr.isatty():
-            from tqdm import tqdm
-
-            try:  # a terminal that reports no size (serial consoles, some CI) gets 80 x 24
-                size = os.get_terminal_size(sys.stderr.fileno())
-            except OSError:
-                size = os.terminal_size((0, 0))
-            self.bar = tqdm(
-                total=total,
-                initial=initial,
-                unit="design",
-                file=sys.stderr,
-                leave=False,
-                ncols=size.columns or 80,
-                nrows=size.lines or 24,
-            )
-
-    def __enter__(self) -> _ProgressBar:
-        return self
-
-    def update(self, n: int) -> None:
-        if self.bar is not None:
-            self.bar.update(n)
-
-    def __exit__(self, *exc: object) -> None:
-        if self.bar is not None:
-            self.bar.close()
