@@ -7,7 +7,8 @@
 >>> out["m10_A"].shape
 (301,)
 
-The runtime imports numpy (matplotlib for figures, scipy for trajectories of positions only);
+The runtime imports numpy (matplotlib for figures, scipy for trajectories of positions only,
+pyarrow and Dask for design studies: :func:`workspace`, :func:`sweep`);
 regeneration lives in the package ``rpr3gen_derive`` (folder ``derive/``) and writes
 ``rpr3gen_generated`` (folder ``generated/``).
 """
@@ -27,8 +28,10 @@ from rpr3gen.control import (
     platform_velocity,
     task_space_dynamics,
 )
+from rpr3gen.design import WorkspaceMap, sweep, workspace, write_workspace
 from rpr3gen.errors import (
     IdentificationError,
+    GridError,
     InputError,
     InputTypeError,
     ModelError,
@@ -62,6 +65,7 @@ __all__ = [
     "OUTPUT_NAMES",
     "PARAM_NAMES",
     "IdentificationError",
+    "GridError",
     "InputError",
     "InputTypeError",
     "Model",
@@ -72,6 +76,7 @@ __all__ = [
     "Trajectory",
     "TrajectoryError",
     "TrajectoryWarning",
+    "WorkspaceMap",
     "__version__",
     "actuator_coordinates",
     "actuator_efforts",
@@ -94,5 +99,8 @@ __all__ = [
     "platform_velocity",
     "read_trajectory_csv",
     "regressor",
+    "sweep",
     "task_space_dynamics",
+    "workspace",
+    "write_workspace",
 ]

@@ -1,5 +1,7 @@
 """The ``rpr3gen`` command: ``simulate``, ``paper`` (the paper's two examples), ``params``,
-``fk``, ``identify``, ``excite`` (:mod:`rpr3gen.cli_identification`) and ``generate``.
+``fk``, ``generate``, the identification's ``identify`` and ``excite``
+(:mod:`rpr3gen.cli_identification`), and the design studies ``workspace`` and ``sweep``
+(:mod:`rpr3gen.design`).
 
 Every failure is one line on stderr (``rpr3gen: error: ...``) and exit status 2; ``--debug``
 shows the traceback instead. The package's warnings are one line each (``rpr3gen: warning:
@@ -22,6 +24,12 @@ import numpy as np
 
 from rpr3gen import __version__, cli_identification, manifest
 from rpr3gen.backends import BACKENDS, OUTPUT_NAMES, inverse_dynamics
+from rpr3gen.design.maps import DEFAULT_RESOLUTION, WorkspaceMap
+from rpr3gen.design.sweeps import (
+    DEFAULT_AREA_RESOLUTION,
+    DEFAULT_CHUNK_SIZE,
+    DEFAULT_TRAJECTORIES,
+)
 from rpr3gen.errors import (
     InputError,
     Rpr3genError,
@@ -178,6 +186,115 @@ def _parser() -> argparse.ArgumentParser:
     fk.add_argument("qa", nargs=3, type=float, metavar="QA", help="actuator coordinate")
 
     cli_identification.add_parsers(sub, paper_model)
+    ws = sub.add_parser(
+        "workspace",
+        help="workspace and singularity maps of a design at a fixed platform angle",
+        description="Map the positions of G reachable at the platform angle PHI (strokes, "
+        "conditioning), the conditioning with the singularity curves, the static actuator "
+        "efforts holding the robot at rest and the reachable orientation range; write "
+        "DIR/workspace.parquet and four PNG figures.",
+    )
+    ws.add_argument("--model", metavar="FILE", help=f"model TOML file ({paper_model})")
+    ws.add_argument(
+        "--phi", type=float, default=0.0, metavar="DEG", help="platform angle, degrees (default: 0)"
+    )
+    ws.add_argument(
+        "--resolution",
+        type=int,
+        default=DEFAULT_RESOLUTION,
+        metavar="N",
+        help=f"grid points along x and along y (default: {DEFAULT_RESOLUTION})",
+    )
+    ws.add_argument(
+        "--out", default="workspace", metavar="DIR", help="output folder (default: ./workspace)"
+    )
+    ws.add_argument(
+        "--min-conditioning",
+        type=_conditioning_threshold,
+        default=DEFAULT_MIN_CONDITIONING,
+        metavar="C",
+        help=f"poses below this conditioning are not reachable (default: "
+        f"{DEFAULT_MIN_CONDITIONING:g})",
+    )
+
+    sw = sub.add_parser(
+        "sweep",
+        help="evaluate every design of a grid of model keys over trajectories (Dask), as Parquet",
+        description="For every design of GRID.toml (dotted model keys set to lists or "
+        "{start, stop, num} ranges, applied to BASE.toml): feasible or not and why, peak and "
+        "RMS actuator efforts, peak joint loads, least conditioning and the workspace area at "
+        "phi = 0; one row per design, in the grid's order.",
+    )
+    sw.add_argument("--model", metavar="BASE.toml", help=f"base model ({paper_model})")
+    sw.add_argument("--grid", required=True, metavar="GRID.toml", help="the designs (required)")
+    sw.add_argument(
+        "--trajectory",
+        action="append",
+        metavar="NAME|FILE.csv",
+        help="'rotation', 'rectilinear' or a trajectory CSV file; repeat for several "
+        "(default: rotation and rectilinear)",
+    )
+    sw.add_argument(
+        "--samples",
+        type=int,
+        default=DEFAULT_SAMPLES,
+        metavar="N",
+        help=f"samples of each paper trajectory (default: {DEFAULT_SAMPLES})",
+    )
+    sw.add_argument(
+        "--duration",
+        type=float,
+        default=DEFAULT_DURATION,
+        metavar="T",
+        help=f"duration of each paper trajectory, s (default: {DEFAULT_DURATION:g})",
+    )
+    sw.add_argument(
+        "--scheduler",
+        metavar="ADDRESS",
+        help="run on the Dask scheduler at ADDRESS, e.g. tcp://host:8786 (default: a local "
+        "cluster on this machine's cores)",
+    )
+    sw.add_argument(
+        "--workers",
+        type=int,
+        metavar="N",
+        help="processes of the local cluster (default: one per core); 0 runs in this process "
+        "without Dask",
+    )
+    sw.add_argument(
+        "--resume",
+        action="store_true",
+        help="continue an interrupted sweep from the chunks in FILE.parquet.parts",
+    )
+    sw.add_argument(
+        "--out",
+        default="sweep.parquet",
+        metavar="FILE.parquet",
+        help="output file (default: ./sweep.parquet)",
+    )
+    sw.add_argument(
+        "--chunk-size",
+        type=int,
+        default=DEFAULT_CHUNK_SIZE,
+        metavar="N",
+        help=f"designs per task and per part file (default: {DEFAULT_CHUNK_SIZE})",
+    )
+    sw.add_argument(
+        "--area-resolution",
+        type=int,
+        default=DEFAULT_AREA_RESOLUTION,
+        metavar="N",
+        help="grid points per axis of each design's workspace area; 0: no area "
+        f"(default: {DEFAULT_AREA_RESOLUTION})",
+    )
+    sw.add_argument(
+        "--min-conditioning",
+        type=_conditioning_threshold,
+        default=DEFAULT_MIN_CONDITIONING,
+        metavar="C",
+        help=f"a pose below this conditioning makes a design infeasible (default: "
+        f"{DEFAULT_MIN_CONDITIONING:g})",
+    )
 
     gen = sub.add_parser("generate", help="derive and write the generated sources")
     gen.add_argument(
@@ -436,6 +553,72 @@ def _cmd_fk(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_workspace(args: argparse.Namespace) -> int:
+    from rpr3gen.design import workspace, write_workspace
+
+    model = load_model(args.model)
+    if not np.isfinite(args.phi):
+        raise InputError(f"--phi: must be a finite angle in degrees, got {args.phi}")
+    if args.resolution < 2:
+        raise InputError(f"--resolution: must be an integer >= 2, got {args.resolution}")
+    out = Path(args.out)
+    _check_destination(out, "the workspace maps", folder=True)
+    wmap = workspace(model, np.radians(args.phi), args.resolution,
+                     min_conditioning=args.min_conditioning)  # fmt: skip
+    written = write_workspace(wmap, out)
+    print(_workspace_summary(wmap))
+    print(f"wrote {written[0]} and {len(written) - 1} figures in {out}")
+    return 0
+
+
+def _workspace_summary(wmap: WorkspaceMap) -> str:
+    reachable = int(np.count_nonzero(wmap.reachable))
+    strokes = ", ".join(f"[{lo:.4g}, {hi:.4g}]" for lo, hi in wmap.stroke)
+    lines = [
+        f"workspace of {wmap.model.name} at phi = {np.degrees(wmap.phi):g} deg: "
+        f"{wmap.x.size} x {wmap.y.size} points, x {wmap.x[0]:.4g} to {wmap.x[-1]:.4g} m, "
+        f"y {wmap.y[0]:.4g} to {wmap.y[-1]:.4g} m",
+        f"  reachable: {reachable} points, area {wmap.area:.5g} m^2 (strokes lambda21 {strokes} "
+        f"m; conditioning >= {wmap.min_conditioning:g})",
+    ]
+    if reachable:
+        peak = float(np.nanmax(np.abs(wmap.tau)))
+        width = np.degrees(np.nanmax(wmap.phi_max - wmap.phi_min))
+        unit = "N m" if wmap.effort == "m10" else "N"
+        lines.append(f"  peak static |{wmap.effort}|: {peak:.5g} {unit}; widest orientation "
+                     f"range: {width:.4g} deg")  # fmt: skip
+    return "\n".join(lines)
+
+
+def _cmd_sweep(args: argparse.Namespace) -> int:
+    from rpr3gen.design import sweep
+    from rpr3gen.design.sweeps import parts_folder
+
+    try:
+        table = sweep(
+            args.model,
+            args.grid,
+            args.trajectory or DEFAULT_TRAJECTORIES,
+            out=args.out,
+            scheduler=args.scheduler,
+            workers=args.workers,
+            resume=args.resume,
+            chunk_size=args.chunk_size,
+            min_conditioning=args.min_conditioning,
+            area_resolution=args.area_resolution,
+            samples=args.samples,
+            duration=args.duration,
+            progress=True,
+        )
+    except KeyboardInterrupt:
+        if parts_folder(args.out).is_dir():
+            _warn(f"the finished chunks are in {parts_folder(args.out)}: rerun with --resume")
+        raise
+    feasible = table.column("feasible").to_numpy(zero_copy_only=False)
+    print(f"{table.num_rows} designs, {int(feasible.sum())} feasible; wrote {args.out}")
+    return 0
+
+
 def _cmd_generate(args: argparse.Namespace) -> int:
     try:
         from rpr3gen_derive.codegen import files as codegen_files
@@ -478,6 +661,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         "paper": _cmd_paper,
         "params": _cmd_params,
         "fk": _cmd_fk,
+        "workspace": _cmd_workspace,
+        "sweep": _cmd_sweep,
         "generate": _cmd_generate,
         "identify": cli_identification.cmd_identify,
         "excite": cli_identification.cmd_excite,

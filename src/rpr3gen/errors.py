@@ -11,6 +11,7 @@ derive from :class:`ValueError`, and those about a value of the wrong type from
     Rpr3genError(Exception)
     ├── ModelError(Rpr3genError, ValueError)        a model file or dictionary
     ├── TrajectoryError(Rpr3genError, ValueError)   a trajectory file or request
+    ├── GridError(Rpr3genError, ValueError)         a design-study grid file or mapping
     ├── InputError(Rpr3genError, ValueError)        an array or argument of the Python API
     └── InputTypeError(Rpr3genError, TypeError)     an argument of the wrong type
 
@@ -27,6 +28,7 @@ import difflib
 from collections.abc import Iterable
 
 __all__ = [
+    "GridError",
     "InputError",
     "InputTypeError",
     "ModelError",
@@ -48,6 +50,10 @@ class ModelError(Rpr3genError, ValueError):
 
 class TrajectoryError(Rpr3genError, ValueError):
     """A trajectory file or a trajectory request is malformed."""
+
+
+class GridError(Rpr3genError, ValueError):
+    """A grid of designs (``rpr3gen sweep --grid``) names an unknown key or a bad value."""
 
 
 class InputError(Rpr3genError, ValueError):

@@ -29,7 +29,16 @@ import numpy as np
 from rpr3gen import manifest
 from rpr3gen.errors import ModelError, Rpr3genError, did_you_mean
 
-__all__ = ["ACTUATIONS", "LEGS", "PARAM_NAMES", "Model", "load_model", "model_from_dict"]
+__all__ = [
+    "ACTUATIONS",
+    "LEGS",
+    "MODEL_KEYS",
+    "PARAM_NAMES",
+    "Model",
+    "load_model",
+    "model_from_dict",
+    "read_model_data",
+]
 
 ACTUATIONS: tuple[str, ...] = ("revolute", "prismatic")
 """Which joint of each leg is driven: the base revolute (the paper) or the prismatic joint."""
@@ -58,6 +67,13 @@ _SCHEMA: dict[str, Any] = {
     "payload": {"force": None, "moment": None},
     "limits": {"stroke": None},
 }
+
+MODEL_KEYS: tuple[str, ...] = tuple(
+    f"{table}.{key}" if isinstance(sub, dict) else table
+    for table, sub in _SCHEMA.items()
+    for key in (sub if isinstance(sub, dict) else (None,))
+)
+"""Every key a model file may hold, dotted (``"geometry.r"``, ``"mass.m3"``, ``"name"``...)."""
 
 
 class _ReadOnlyParams(Mapping[str, float]):
@@ -162,6 +178,25 @@ def load_model(
         ModelError: If the file cannot be read, is not valid TOML, or any key or value is wrong;
             the one-line message names the file and the dotted key.
     """
+    source, data = read_model_data(path)
+    model = model_from_dict(data, source=source)
+    if generated is None:
+        return model
+    return dataclasses.replace(model, generated=os.fspath(generated))
+
+
+def read_model_data(path: str | os.PathLike[str] | None = None) -> tuple[str, dict[str, Any]]:
+    """Read a model file as parsed TOML, not yet validated (see :func:`model_from_dict`).
+
+    Args:
+        path: A TOML model file; ``None`` reads the packaged paper robot.
+
+    Returns:
+        The file's name for messages and its tables as nested dictionaries.
+
+    Raises:
+        ModelError: If the file cannot be read or is not valid UTF-8 TOML.
+    """
     if path is None:
         resource = importlib.resources.files("rpr3gen") / "models" / "paper.toml"
         source, read_bytes = str(resource), resource.read_bytes
@@ -184,10 +219,7 @@ def load_model(
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ModelError(f"{source}: invalid TOML: {_one_line(str(exc))}") from None
-    model = model_from_dict(data, source=source)
-    if generated is None:
-        return model
-    return dataclasses.replace(model, generated=os.fspath(generated))
+    return source, data
 
 
 def model_from_dict(data: Mapping[str, Any], source: str = "<dict>") -> Model:

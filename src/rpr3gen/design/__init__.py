@@ -1,0 +1,17 @@
+"""Design studies: workspace and singularity maps of one design, and sweeps over many.
+
+- :func:`workspace` maps one design at a fixed platform angle (:mod:`.maps`), and
+  :func:`write_workspace` writes the map as Parquet and four figures (:mod:`.outputs`).
+- :func:`sweep` evaluates every design of a grid (:mod:`.grid`) over trajectories
+  (:mod:`.metrics`), in chunks (:mod:`.sweeps`) on Dask (:mod:`.cluster`), as Parquet
+  (:mod:`.parquet`).
+
+Both evaluate the generated NumPy code with one parameter vector per sample
+(:mod:`.stacked`), and count a pose reachable as :mod:`.reach` says.
+"""
+
+from rpr3gen.design.maps import WorkspaceMap, workspace
+from rpr3gen.design.outputs import write_workspace
+from rpr3gen.design.sweeps import sweep
+
+__all__ = ["WorkspaceMap", "sweep", "workspace", "write_workspace"]

@@ -1,0 +1,200 @@
+"""The four workspace figures: reachable region, conditioning with the singularity curves, peak
+static effort, orientation range.
+
+Drawn as :mod:`rpr3gen.plots` draws: a :class:`~matplotlib.figure.Figure` on the Agg canvas (no
+``pyplot`` state), fixed size, resolution and PNG metadata, written atomically; the same map
+gives the same files.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from matplotlib import patheffects
+from matplotlib.axes import Axes
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.colors import ListedColormap, LogNorm
+from matplotlib.figure import Figure
+from matplotlib.image import AxesImage
+from matplotlib.lines import Line2D
+
+from rpr3gen.atomic import atomic_write
+from rpr3gen.design.maps import WorkspaceMap
+from rpr3gen.model import LEGS
+from rpr3gen.plots import DPI
+
+__all__ = ["FIGSIZE", "FIGURES", "write_figures"]
+
+FIGSIZE = (6.4, 6.4)
+"""Figure size, inches."""
+
+LEG_COLORS = {"A": "tab:blue", "B": "tab:orange", "C": "tab:green"}
+"""Colour of each leg's pivot and stroke-limit curves."""
+
+_UNITS = {"m10": "N·m", "f21z": "N"}
+
+
+def _frame(wmap: WorkspaceMap, title: str) -> tuple[Figure, Axes]:
+    fig = Figure(figsize=FIGSIZE, dpi=DPI, layout="constrained")
+    FigureCanvasAgg(fig)
+    ax = fig.add_subplot()
+    ax.set_aspect("equal")
+    ax.set_xlabel("x of G [m]")
+    ax.set_ylabel("y of G [m]")
+    phi = f"φ = {math.degrees(wmap.phi):.4g}°"
+    ax.set_title(f"{title}\n{wmap.model.name}, {phi}")
+    return fig, ax
+
+
+def _legend(fig: Figure, handles: list[Line2D]) -> None:
+    """The legend below the map, where it hides nothing."""
+    fig.legend(handles=handles, loc="outside lower center", ncols=3, fontsize="small")
+
+
+def _extent(wmap: WorkspaceMap) -> tuple[float, float, float, float]:
+    dx = (wmap.x[1] - wmap.x[0]) / 2 if wmap.x.size > 1 else 0.0
+    dy = (wmap.y[1] - wmap.y[0]) / 2 if wmap.y.size > 1 else 0.0
+    return (wmap.x[0] - dx, wmap.x[-1] + dx, wmap.y[0] - dy, wmap.y[-1] + dy)
+
+
+def _image(ax: Axes, wmap: WorkspaceMap, values: np.ndarray, **kw: Any) -> AxesImage:
+    return ax.imshow(
+        np.ma.masked_invalid(values),
+        origin="lower",
+        extent=_extent(wmap),
+        interpolation="nearest",
+        **kw,
+    )
+
+
+def _outline(ax: Axes, wmap: WorkspaceMap, color: str = "k") -> list[Line2D]:
+    """The edge of the reachable region (a white line gets a black rim, to show in the legend)."""
+    if not (wmap.reachable.any() and not wmap.reachable.all()):
+        return []
+    rim = [patheffects.withStroke(linewidth=2.5, foreground="k")] if color == "white" else None
+    contours = ax.contour(wmap.x, wmap.y, wmap.reachable.astype(float), levels=[0.5],
+                          colors=color, linewidths=1.0)  # fmt: skip
+    contours.set(path_effects=rim)
+    return [Line2D([], [], color=color, linewidth=1.0, path_effects=rim,
+                   label="edge of the reachable region")]  # fmt: skip
+
+
+def _pivots(ax: Axes, wmap: WorkspaceMap) -> list[Line2D]:
+    """The base pivots A1, B1, C1 (inside the box or not; the axes keep the grid's limits)."""
+    p = wmap.model.params
+    handles = []
+    for leg in LEGS:
+        (h,) = ax.plot(
+            p[f"x{leg}1"],
+            p[f"y{leg}1"],
+            marker="^",
+            markersize=9,
+            linestyle="none",
+            color=LEG_COLORS[leg],
+            markeredgecolor="k",
+            label=f"base pivot {leg}1",
+        )
+        handles.append(h)
+    x0, x1, y0, y1 = _extent(wmap)
+    ax.set_xlim(x0, x1)
+    ax.set_ylim(y0, y1)
+    return handles
+
+
+def reachable_figure(wmap: WorkspaceMap) -> Figure:
+    """The reachable region, with its area."""
+    fig, ax = _frame(wmap, f"Reachable workspace: {wmap.area:.4g} m²")
+    cmap = ListedColormap(["#f2f2f2", "#4c8bc9"])
+    _image(ax, wmap, wmap.reachable.astype(float), cmap=cmap, vmin=0.0, vmax=1.0)
+    handles = _outline(ax, wmap) + _pivots(ax, wmap)
+    strokes = ", ".join(f"[{lo:.3g}, {hi:.3g}]" for lo, hi in wmap.stroke)
+    ax.text(0.01, 0.01, f"strokes λ21 (m): {strokes}; conditioning ≥ {wmap.min_conditioning:g}",
+            transform=ax.transAxes, fontsize="small", va="bottom")  # fmt: skip
+    _legend(fig, handles)
+    return fig
+
+
+def conditioning_figure(wmap: WorkspaceMap) -> Figure:
+    """Conditioning heat map with the parallel (conditioning 0) and serial (stroke limit)
+    singularity curves."""
+    fig, ax = _frame(wmap, "Conditioning and singularity curves")
+    image = _image(ax, wmap, wmap.conditioning, cmap="viridis", vmin=0.0, vmax=1.0)
+    fig.colorbar(image, ax=ax, label="conditioning (0 = parallel singularity)", shrink=0.8)
+    handles = []
+    signed = np.ma.masked_invalid(wmap.jacobian_sign * wmap.conditioning)
+    if signed.count() and signed.min() < 0 < signed.max():
+        ax.contour(wmap.x, wmap.y, signed, levels=[0.0], colors="red", linewidths=2.0)
+        handles.append(Line2D([], [], color="red", linewidth=2.0,
+                              label="parallel singularity (conditioning 0)"))  # fmt: skip
+    for k, leg in enumerate(LEGS):
+        lam = np.ma.masked_invalid(wmap.lambda21[..., k])
+        lo, hi = wmap.stroke[k]
+        levels = [v for v in (lo, hi) if lam.count() and lam.min() < v < lam.max()]
+        if levels:
+            ax.contour(wmap.x, wmap.y, lam, levels=levels, colors=LEG_COLORS[leg],
+                       linestyles="--", linewidths=1.5)  # fmt: skip
+            handles.append(Line2D([], [], color=LEG_COLORS[leg], linestyle="--",
+                                  label=f"stroke limit, leg {leg}"))  # fmt: skip
+    handles += _outline(ax, wmap, color="white")
+    handles += _pivots(ax, wmap)
+    _legend(fig, handles)
+    return fig
+
+
+def effort_figure(wmap: WorkspaceMap) -> Figure:
+    """The largest static actuator effort of the three legs at each reachable point."""
+    unit = _UNITS[wmap.effort]
+    fig, ax = _frame(wmap, f"Peak static effort max |{wmap.effort}| over legs A, B, C")
+    peak = np.max(np.abs(wmap.tau), axis=2)
+    finite = peak[np.isfinite(peak) & (peak > 0)]
+    if finite.size:
+        norm = LogNorm(vmin=float(finite.min()), vmax=float(finite.max()))
+        image = _image(ax, wmap, np.where(peak > 0, peak, np.nan), cmap="magma", norm=norm)
+        fig.colorbar(image, ax=ax, label=f"max |{wmap.effort}| [{unit}] (log scale)", shrink=0.8)
+    handles = _outline(ax, wmap) + _pivots(ax, wmap)
+    _legend(fig, handles)
+    return fig
+
+
+def orientation_figure(wmap: WorkspaceMap) -> Figure:
+    """The width of the reachable orientation interval through each point."""
+    fig, ax = _frame(wmap, "Reachable orientation range φ_max − φ_min")
+    width = np.degrees(wmap.phi_max - wmap.phi_min)
+    if np.isfinite(width).any():
+        image = _image(ax, wmap, width, cmap="cividis", vmin=0.0)
+        fig.colorbar(image, ax=ax, label="φ_max − φ_min [°]", shrink=0.8)
+    handles = _outline(ax, wmap) + _pivots(ax, wmap)
+    _legend(fig, handles)
+    return fig
+
+
+FIGURES: dict[str, Callable[[WorkspaceMap], Figure]] = {
+    "reachable": reachable_figure,
+    "conditioning": conditioning_figure,
+    "peak_effort": effort_figure,
+    "orientation_range": orientation_figure,
+}
+"""The figures by file name (without ``.png``)."""
+
+
+def write_figures(wmap: WorkspaceMap, outdir: str | os.PathLike[str]) -> list[Path]:
+    """Write the four figures as ``outdir/<name>.png`` (:data:`FIGURES`), atomically.
+
+    Returns:
+        The paths written, in the order of :data:`FIGURES`.
+    """
+    folder = Path(outdir)
+    folder.mkdir(parents=True, exist_ok=True)
+    written = []
+    for name, draw in FIGURES.items():
+        path = folder / f"{name}.png"
+        fig = draw(wmap)
+        with atomic_write(path, "wb") as f:
+            fig.savefig(f, format="png", dpi=DPI, metadata={"Software": None})
+        written.append(path)
+    return written

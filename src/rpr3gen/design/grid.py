@@ -1,0 +1,312 @@
+"""Grids of designs: which model keys a sweep varies, and the designs they enumerate.
+
+A grid file (TOML) sets dotted model keys to their values, a list or a range with a count::
+
+    "geometry.r" = [0.25, 0.3, 0.35]
+    "mass.m3" = { start = 2.0, stop = 8.0, num = 4 }     # numpy.linspace: both ends included
+    "geometry.alpha_deg[0]" = [80.0, 90.0]               # one element of a list-valued key
+    actuation = ["revolute", "prismatic"]
+
+Tables are dotted keys too (``[mass]`` then ``m3 = [...]`` is ``"mass.m3"``). The designs are
+every combination, in the order of the keys, the last key fastest (``itertools.product``).
+
+Every key and every value is checked before any work: an unknown key (with the close match), a
+value that is not a list or a range, or a value that makes the base model invalid is a
+:class:`~rpr3gen.errors.GridError` naming the file and the key.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+import os
+import re
+import tomllib
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from rpr3gen.errors import GridError, ModelError, did_you_mean
+from rpr3gen.model import ACTUATIONS, DEFAULT_GRAVITY, MODEL_KEYS, Model, model_from_dict
+
+__all__ = ["Grid", "read_grid"]
+
+#: Model keys that hold a list, with its shape: vary one element, ``key[i]`` or ``key[i][j]``.
+LIST_SHAPES: Mapping[str, tuple[int, ...]] = {
+    "geometry.alpha_deg": (3,),
+    "geometry.base": (3, 2),
+    "geometry.platform": (3, 2),
+    "environment.gravity": (2,),
+    "payload.force": (2,),
+    "limits.stroke": (3, 2),
+}
+#: Lists a model may leave out, and the value they then have.
+_LIST_DEFAULTS: Mapping[str, Any] = {
+    "environment.gravity": list(DEFAULT_GRAVITY),
+    "payload.force": [0.0, 0.0],
+}
+#: Model keys that are not design parameters.
+_NOT_PARAMETERS = ("name",)
+_TEXT_KEYS = ("actuation",)
+_RANGE_KEYS = ("start", "stop", "num")
+_KEY = re.compile(r"^(?P<key>[A-Za-z_][A-Za-z0-9_.]*?)(?P<index>(\[\d+\])*)$")
+
+
+@dataclass(frozen=True)
+class Grid:
+    """The designs of a sweep: the keys varied and the values of each.
+
+    Attributes:
+        keys: dotted model keys, as named in the grid (e.g. ``"geometry.r"``,
+            ``"geometry.alpha_deg[0]"``), in the grid's order.
+        values: per key, its values: floats, or strings for ``actuation``.
+        source: the grid's file name (or ``"<grid>"``), for messages.
+    """
+
+    keys: tuple[str, ...]
+    values: tuple[tuple[Any, ...], ...]
+    source: str = "<grid>"
+
+    @property
+    def shape(self) -> tuple[int, ...]:
+        """Values per key."""
+        return tuple(len(v) for v in self.values)
+
+    def __len__(self) -> int:
+        """Number of designs."""
+        return math.prod(self.shape)
+
+    def design(self, index: int) -> tuple[Any, ...]:
+        """The values of design ``index`` (0-based, the grid's order), one per key."""
+        where = np.unravel_index(index, self.shape)
+        return tuple(v[int(k)] for v, k in zip(self.values, where, strict=True))
+
+    def columns(self, start: int, stop: int) -> dict[str, np.ndarray]:
+        """The key columns of designs ``start`` to ``stop - 1``: float64, or object (text)."""
+        where = np.unravel_index(np.arange(start, stop), self.shape)
+        columns = {}
+        for key, values, k in zip(self.keys, self.values, where, strict=True):
+            kind = object if key in _TEXT_KEYS else np.float64
+            columns[key] = np.array(values, dtype=kind)[k]
+        return columns
+
+    def apply(self, base: Mapping[str, Any], values: Sequence[Any]) -> dict[str, Any]:
+        """A copy of the model data ``base`` with the keys set to ``values``."""
+        # Tables are copied; leaves are replaced, never changed in place (lists by _set).
+        data = {k: dict(v) if isinstance(v, Mapping) else v for k, v in base.items()}
+        for key, value in zip(self.keys, values, strict=True):
+            _set(data, key, value)
+        return data
+
+    def as_dict(self) -> dict[str, list[Any]]:
+        """``{key: values}``: the grid as a mapping :func:`read_grid` reads back."""
+        return {key: list(values) for key, values in zip(self.keys, self.values, strict=True)}
+
+
+def read_grid(grid: str | os.PathLike[str] | Mapping[str, Any], base: Mapping[str, Any]) -> Grid:
+    """Read and check a grid against the base model data (parsed TOML, see
+    :func:`rpr3gen.model.read_model_data`).
+
+    Args:
+        grid: a grid file (TOML), or the same content as a mapping.
+        base: the base model's data; every value is checked on it, one key at a time.
+
+    Raises:
+        GridError: naming the grid and the key at fault.
+    """
+    if isinstance(grid, Mapping):
+        source, data = "<grid>", grid
+    else:
+        source, data = os.fspath(grid), _read(os.fspath(grid))
+    flat: dict[str, Any] = {}
+    _flatten(data, "", flat, source)
+    if not flat:
+        raise GridError(
+            f'{source}: no keys; set model keys to values, e.g. "geometry.r" = [0.25, 0.3]'
+        )
+    keys, values = [], []
+    for key, given in flat.items():
+        _check_key(key, base, source)
+        keys.append(key)
+        values.append(_values(key, given, source))
+    grid_ = Grid(keys=tuple(keys), values=tuple(values), source=source)
+    for key, vals in zip(grid_.keys, grid_.values, strict=True):
+        for value in vals:
+            try:
+                data_ = Grid((key,), ((value,),)).apply(base, (value,))
+                model_from_dict(data_, source=f"{source}: {key} = {_show(value)}")
+            except ModelError as exc:
+                raise GridError(str(exc)) from None
+    return grid_
+
+
+def design_model(grid: Grid, base: Mapping[str, Any], index: int, source: str) -> Model:
+    """The model of design ``index``.
+
+    Raises:
+        ModelError: when the combination of values makes an invalid model (each value alone
+            was valid, :func:`read_grid` checked that).
+    """
+    return model_from_dict(grid.apply(base, grid.design(index)), source=source)
+
+
+def _read(path: str) -> dict[str, Any]:
+    try:
+        text = Path(path).read_bytes().decode("utf-8")
+    except FileNotFoundError:
+        raise GridError(f"{path}: grid file not found") from None
+    except IsADirectoryError:
+        raise GridError(f"{path}: is a directory, not a grid file") from None
+    except OSError as exc:
+        raise GridError(f"{path}: cannot read grid file: {exc.strerror or exc}") from None
+    except UnicodeDecodeError as exc:
+        raise GridError(f"{path}: not UTF-8 text (bad byte at offset {exc.start})") from None
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise GridError(f"{path}: invalid TOML: {' '.join(str(exc).splitlines())}") from None
+
+
+def _is_range(value: Any) -> bool:
+    return isinstance(value, Mapping) and any(k in value for k in _RANGE_KEYS)
+
+
+def _flatten(table: Mapping[str, Any], prefix: str, flat: dict[str, Any], source: str) -> None:
+    for key, value in table.items():
+        dotted = f"{prefix}{key}"
+        if isinstance(value, Mapping) and not _is_range(value):
+            if not value:
+                raise GridError(f"{source}: {dotted}: an empty table; give values")
+            _flatten(value, f"{dotted}.", flat, source)
+        elif dotted in flat:
+            raise GridError(f"{source}: {dotted}: given twice")
+        else:
+            flat[dotted] = value
+
+
+def _split(key: str) -> tuple[str, tuple[int, ...]]:
+    """``"geometry.base[1][0]"`` -> ``("geometry.base", (1, 0))``."""
+    found = _KEY.match(key)
+    if found is None:
+        return key, ()
+    index = tuple(int(i) for i in re.findall(r"\[(\d+)\]", found["index"]))
+    return found["key"], index
+
+
+def _check_key(key: str, base: Mapping[str, Any], source: str) -> None:
+    name, index = _split(key)
+    if name not in MODEL_KEYS:
+        hint = did_you_mean(name, MODEL_KEYS)
+        raise GridError(f"{source}: {key}: unknown model key{hint}")
+    if name in _NOT_PARAMETERS:
+        raise GridError(f"{source}: {key}: not a design parameter")
+    shape = LIST_SHAPES.get(name)
+    if shape is None:
+        if index:
+            raise GridError(f"{source}: {key}: {name} holds one value, not a list")
+        return
+    if len(index) != len(shape):
+        example = name + "".join("[0]" for _ in shape)
+        raise GridError(f'{source}: {key}: {name} holds a list; vary one element, e.g. "{example}"')
+    for i, n in zip(index, shape, strict=True):
+        if i >= n:
+            raise GridError(f"{source}: {key}: index {i} out of range (0 to {n - 1})")
+    if _get(base, name) is None and name not in _LIST_DEFAULTS:
+        raise GridError(
+            f"{source}: {key}: the base model has no {name} to vary; set it in the model file"
+        )
+
+
+def _values(key: str, given: Any, source: str) -> tuple[Any, ...]:
+    text = key in _TEXT_KEYS
+    if _is_range(given):
+        if text:
+            raise GridError(f"{source}: {key}: a range needs numbers; give a list of values")
+        return _range(key, given, source)
+    if not isinstance(given, list):
+        raise GridError(
+            f"{source}: {key}: must be a list of values or a range "
+            f"{{ start = ..., stop = ..., num = ... }}, got {_show(given)}"
+        )
+    if not given:
+        raise GridError(f"{source}: {key}: an empty list; give at least one value")
+    out: list[Any] = []
+    for i, value in enumerate(given):
+        if text:
+            if not isinstance(value, str):
+                raise GridError(f"{source}: {key}[{i}]: must be text, got {_show(value)}")
+            if value not in ACTUATIONS:
+                hint = did_you_mean(value, ACTUATIONS)
+                raise GridError(
+                    f"{source}: {key}[{i}]: must be one of {', '.join(ACTUATIONS)}, "
+                    f"got {_show(value)}{hint}"
+                )
+            out.append(value)
+        else:
+            out.append(_number(f"{key}[{i}]", value, source))
+    return tuple(out)
+
+
+def _range(key: str, given: Mapping[str, Any], source: str) -> tuple[float, ...]:
+    for name in given:
+        if name not in _RANGE_KEYS:
+            hint = did_you_mean(str(name), _RANGE_KEYS)
+            raise GridError(f"{source}: {key}: unknown range key {name!r}{hint}")
+    missing = [name for name in _RANGE_KEYS if name not in given]
+    if missing:
+        raise GridError(
+            f"{source}: {key}: a range needs start, stop and num; missing {', '.join(missing)}"
+        )
+    start = _number(f"{key}.start", given["start"], source)
+    stop = _number(f"{key}.stop", given["stop"], source)
+    num = given["num"]
+    if isinstance(num, bool) or not isinstance(num, int) or num < 1:
+        raise GridError(f"{source}: {key}.num: must be an integer >= 1, got {_show(num)}")
+    return tuple(float(v) for v in np.linspace(start, stop, num))
+
+
+def _number(where: str, value: Any, source: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        raise GridError(f"{source}: {where}: must be a number, got {_show(value)}")
+    if not math.isfinite(value):
+        raise GridError(f"{source}: {where}: must be a finite number, got {_show(value)}")
+    return float(value)
+
+
+def _show(value: Any) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, str):
+        return f'"{value}"'
+    if isinstance(value, Mapping):
+        return "a table"
+    if isinstance(value, list):
+        return f"a list of {len(value)}"
+    return repr(value)
+
+
+def _get(data: Mapping[str, Any], name: str) -> Any:
+    table, _, key = name.rpartition(".")
+    inner = data.get(table, {}) if table else data
+    return inner.get(key) if isinstance(inner, Mapping) else None
+
+
+def _set(data: dict[str, Any], key: str, value: Any) -> None:
+    name, index = _split(key)
+    table, _, leaf = name.rpartition(".")
+    inner = data.setdefault(table, {}) if table else data
+    if not index:
+        inner[leaf] = value
+        return
+    current = inner.get(leaf)
+    if current is None:
+        current = copy.deepcopy(_LIST_DEFAULTS[name])
+    current = copy.deepcopy(list(current))
+    inner[leaf] = current
+    for i in index[:-1]:
+        current[i] = list(current[i])
+        current = current[i]
+    current[index[-1]] = value

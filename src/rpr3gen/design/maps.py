@@ -1,0 +1,293 @@
+"""The workspace map of one design at a fixed platform angle.
+
+On a grid of positions of G at the angle ``phi``: whether the pose is reachable
+(:mod:`rpr3gen.design.reach`), its ``conditioning`` (0 at a parallel singularity), the static
+actuator efforts that hold the robot at rest there against gravity and the payload, and the
+interval of platform angles ``[phi_min, phi_max]`` reachable through the point that contains
+``phi``.
+
+The interval is found for all points at once: march away from ``phi`` in steps of
+:data:`ORIENTATION_STEP`, both ways, until a pose is not reachable (or half a turn is), then
+bisect the last step :data:`BISECTIONS` times. A gap narrower than the step can be missed.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from rpr3gen.design.reach import (
+    design_stroke,
+    jacobian_sign,
+    pose_extent,
+    reachable_signed,
+    within,
+)
+from rpr3gen.design.stacked import evaluate_stacked, leg_lengths, piston_displacements
+from rpr3gen.errors import InputError, InputTypeError
+from rpr3gen.model import LEGS, Model
+from rpr3gen.policy import DEFAULT_MIN_CONDITIONING
+
+__all__ = [
+    "BISECTIONS",
+    "COLUMNS",
+    "DEFAULT_RESOLUTION",
+    "ORIENTATION_STEP",
+    "WorkspaceMap",
+    "workspace",
+]
+
+DEFAULT_RESOLUTION = 200
+"""Grid points along x and along y."""
+
+ORIENTATION_STEP = math.radians(0.5)
+"""Step of the march over platform angles (rad)."""
+
+BISECTIONS = 30
+"""Halvings of the last step at each edge of the orientation interval: to about 1e-11 rad."""
+
+_MARCH = 16  # angle steps evaluated per point at a time
+
+COLUMNS: tuple[str, ...] = (
+    "x",
+    "y",
+    "phi",
+    "reachable",
+    "conditioning",
+    "tau_A",
+    "tau_B",
+    "tau_C",
+    "phi_min",
+    "phi_max",
+)
+"""Columns of ``workspace.parquet`` (docs/interfaces.md, "Design studies")."""
+
+
+@dataclass(frozen=True, eq=False)
+class WorkspaceMap:
+    """The maps of one design at one platform angle; arrays (ny, nx) unless said otherwise.
+
+    Attributes:
+        model: the design.
+        phi: the platform angle of the map, rad.
+        min_conditioning: the least ``conditioning`` counted reachable.
+        stroke: the strokes used, ``((lo, hi), ...)`` of legs A, B, C (m).
+        x: (nx,) positions of G along x0, the centres of the grid's cells (m).
+        y: (ny,) along y0 (m).
+        reachable: bool.
+        conditioning: the generated ``conditioning`` of the pose, 0 at a parallel singularity
+            and 1 at best, wherever every leg has a length (NaN elsewhere), reachable or not.
+        jacobian_sign: the sign of ``det J`` (the actuator Jacobian): it changes across a
+            parallel singularity, where ``conditioning`` touches 0.
+        lambda21: (ny, nx, 3) piston displacement of each leg (m).
+        tau: (ny, nx, 3) static actuator efforts ``m10`` (N m) or ``f21z`` (N) of legs A, B, C
+            holding the robot at rest, NaN where not reachable.
+        phi_min, phi_max: the reachable interval of platform angles through the point that
+            contains ``phi`` (rad), NaN where not reachable; at most half a turn each way.
+    """
+
+    model: Model
+    phi: float
+    min_conditioning: float
+    stroke: tuple[tuple[float, float], ...]
+    x: np.ndarray
+    y: np.ndarray
+    reachable: np.ndarray
+    conditioning: np.ndarray
+    jacobian_sign: np.ndarray
+    lambda21: np.ndarray
+    tau: np.ndarray
+    phi_min: np.ndarray
+    phi_max: np.ndarray
+    effort: str = field(init=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "effort", "m10" if self.model.actuation == "revolute" else "f21z")
+
+    @property
+    def cell_area(self) -> float:
+        """Area of one grid cell (m²)."""
+        return _spacing(self.x) * _spacing(self.y)
+
+    @property
+    def area(self) -> float:
+        """Reachable area (m²): the reachable cells times their area."""
+        return float(np.count_nonzero(self.reachable)) * self.cell_area
+
+    def columns(self) -> dict[str, np.ndarray]:
+        """The grid as the columns :data:`COLUMNS`, one row per point, x fastest."""
+        xx, yy = np.meshgrid(self.x, self.y)
+        flat = {
+            "x": xx.ravel(),
+            "y": yy.ravel(),
+            "phi": np.full(xx.size, self.phi),
+            "reachable": self.reachable.ravel(),
+            "conditioning": self.conditioning.ravel(),
+        }
+        for k, leg in enumerate(LEGS):
+            flat[f"tau_{leg}"] = self.tau[..., k].ravel()
+        flat["phi_min"] = self.phi_min.ravel()
+        flat["phi_max"] = self.phi_max.ravel()
+        return flat
+
+
+def _spacing(centres: np.ndarray) -> float:
+    return float(centres[1] - centres[0]) if centres.size > 1 else 0.0
+
+
+def _check(phi: float, resolution: int, min_conditioning: float) -> None:
+    if isinstance(resolution, bool) or not isinstance(resolution, int | np.integer):
+        raise InputTypeError(f"resolution: must be an integer >= 2, got {resolution!r}")
+    if resolution < 2:
+        raise InputError(f"resolution: must be an integer >= 2, got {resolution!r}")
+    if not math.isfinite(phi):
+        raise InputError(f"phi: must be a finite angle (rad), got {phi!r}")
+    if not 0.0 <= min_conditioning < 1.0:
+        raise InputError(f"min_conditioning: must be in [0, 1), got {min_conditioning!r}")
+
+
+def cell_centres(lo: float, hi: float, n: int) -> np.ndarray:
+    """``n`` centres of equal cells between ``lo`` and ``hi``."""
+    return lo + (np.arange(n) + 0.5) * ((hi - lo) / n)
+
+
+def workspace(
+    model: Model,
+    phi: float = 0.0,
+    resolution: int = DEFAULT_RESOLUTION,
+    *,
+    min_conditioning: float = DEFAULT_MIN_CONDITIONING,
+) -> WorkspaceMap:
+    """The workspace map of ``model`` at the platform angle ``phi``.
+
+    The grid has ``resolution`` x ``resolution`` cells over the box that holds every position
+    reachable at ``phi`` (:func:`rpr3gen.design.reach.pose_extent`); each point is a cell's
+    centre.
+
+    Args:
+        model: the design (its ``[limits] stroke``, or the default of
+            :func:`rpr3gen.design.reach.design_stroke`).
+        phi: platform angle, rad.
+        resolution: grid points along each axis, at least 2.
+        min_conditioning: the least ``conditioning`` counted reachable, in [0, 1).
+
+    Raises:
+        InputError, InputTypeError: for a bad argument.
+    """
+    _check(phi, resolution, min_conditioning)
+    phi = float(phi)
+    params = model.vector()
+    stroke = np.array(design_stroke(model))
+    x0, x1, y0, y1 = pose_extent(params, phi, stroke[:, 1])
+    if not (x0 < x1 and y0 < y1):  # nothing reachable: show where the legs could be
+        x0, x1, y0, y1 = _union_box(params, phi, stroke[:, 1])
+    x, y = cell_centres(x0, x1, resolution), cell_centres(y0, y1, resolution)
+    xx, yy = np.meshgrid(x, y)
+    q = np.column_stack([xx.ravel(), yy.ravel(), np.full(xx.size, phi)])
+    zero = np.zeros_like(q)
+
+    statics = evaluate_stacked(model, "actuator_efforts", params, [q, zero, zero])
+    jacobian = evaluate_stacked(model, "actuator_jacobian", params, [q])
+    lengths = leg_lengths(params, q)
+    lambda21 = piston_displacements(params, q)
+    conditioning = np.where(np.isfinite(statics["conditioning"]) & (lengths > 0).all(axis=1),
+                            statics["conditioning"], np.nan)  # fmt: skip
+    ok = within(statics.ok(), conditioning, lambda21, stroke, min_conditioning)
+    sign = jacobian_sign(jacobian.values)
+    efforts = np.stack([statics[name] for name in statics.groups["tau"]], axis=1)
+    tau = np.where(ok[:, np.newaxis], efforts, np.nan)
+
+    phi_min = np.full(q.shape[0], np.nan)
+    phi_max = np.full(q.shape[0], np.nan)
+    inside = np.flatnonzero(ok)
+    if inside.size:
+        origin = (q[inside, :2], sign[inside])
+        phi_min[inside] = phi - _edge(model, params, origin, phi, -1.0, stroke, min_conditioning)
+        phi_max[inside] = phi + _edge(model, params, origin, phi, +1.0, stroke, min_conditioning)
+
+    shape = xx.shape
+    return WorkspaceMap(
+        model=model,
+        phi=phi,
+        min_conditioning=float(min_conditioning),
+        stroke=tuple((float(lo), float(hi)) for lo, hi in stroke),
+        x=x,
+        y=y,
+        reachable=ok.reshape(shape),
+        conditioning=conditioning.reshape(shape),
+        jacobian_sign=sign.reshape(shape),
+        lambda21=lambda21.reshape(*shape, 3),
+        tau=tau.reshape(*shape, 3),
+        phi_min=phi_min.reshape(shape),
+        phi_max=phi_max.reshape(shape),
+    )
+
+
+def _union_box(params: np.ndarray, phi: float, hi: np.ndarray) -> np.ndarray:
+    """The box of the three discs together (when they share none)."""
+    boxes = [pose_extent(params, phi, np.where(np.arange(3) == k, hi[k], np.inf)) for k in range(3)]
+    return np.array(
+        [
+            min(b[0] for b in boxes),
+            max(b[1] for b in boxes),
+            min(b[2] for b in boxes),
+            max(b[3] for b in boxes),
+        ]
+    )
+
+
+def _edge(
+    model: Model,
+    params: np.ndarray,
+    origin: tuple[np.ndarray, np.ndarray],
+    phi: float,
+    direction: float,
+    stroke: np.ndarray,
+    min_conditioning: float,
+) -> np.ndarray:
+    """How far (rad, in [0, pi]) the platform turns from ``phi`` in ``direction`` at each
+    position, every pose on the way reachable.
+
+    ``origin``: the positions (k, 2) and the sign of ``det J`` there at ``phi`` (k,). A pose
+    counts as reached on the way only with the same sign: a change means that a parallel
+    singularity lies between two steps, even one narrower than a step.
+    """
+    xy, sign = origin
+    k = xy.shape[0]
+    steps = math.ceil(math.pi / ORIENTATION_STEP)
+    offsets = np.minimum(ORIENTATION_STEP * np.arange(1, steps + 1), math.pi)
+    good = np.zeros(k)  # the largest offset known reachable
+    bad = np.full(k, np.nan)  # the smallest offset known not reachable
+    open_ = np.arange(k)
+
+    def reaches(rows: np.ndarray, offset: np.ndarray) -> np.ndarray:
+        q = np.column_stack([xy[rows], phi + direction * offset])
+        ok, signs = reachable_signed(model, params, q, stroke, min_conditioning)
+        return ok & (signs == sign[rows])
+
+    for start in range(0, steps, _MARCH):
+        if not open_.size:
+            break
+        block = offsets[start : start + _MARCH]
+        rows = np.repeat(open_, block.size)
+        ok = reaches(rows, np.tile(block, open_.size)).reshape(open_.size, block.size)
+        failed = ~ok.all(axis=1)
+        first = np.argmin(ok, axis=1)
+        hit = open_[failed]
+        bad[hit] = block[first[failed]]
+        after = first[failed] > 0
+        good[hit[after]] = block[first[failed][after] - 1]
+        good[open_[~failed]] = block[-1]
+        open_ = open_[~failed]
+
+    closed = np.flatnonzero(np.isfinite(bad))
+    lo, hi = good[closed], bad[closed]
+    for _ in range(BISECTIONS):
+        mid = 0.5 * (lo + hi)
+        ok = reaches(closed, mid)
+        lo = np.where(ok, mid, lo)
+        hi = np.where(ok, hi, mid)
+    good[closed] = lo
+    return good

@@ -1,0 +1,276 @@
+"""What a sweep measures of each design, for a chunk of designs at once.
+
+For every design of the chunk, over all the sweep's trajectories: whether it is feasible (every
+pose reachable, :mod:`rpr3gen.design.reach`) and, if not, why (the first trajectory and time at
+fault), the peak and RMS actuator effort per leg, the peak joint load per output family, the
+least conditioning; and the reachable area at ``phi = 0``.
+
+The designs are evaluated together: each generated call takes designs x samples, one parameter
+column per sample (:mod:`rpr3gen.design.stacked`). Designs whose actuation differs use different
+generated code, so a chunk is evaluated per actuation.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from rpr3gen.backends import BLOCK
+from rpr3gen.design.grid import Grid, design_model
+from rpr3gen.design.maps import cell_centres
+from rpr3gen.design.reach import design_stroke, pose_extent, reachable, within
+from rpr3gen.design.stacked import evaluate_stacked, param_rows
+from rpr3gen.errors import ModelError
+from rpr3gen.manifest import load as load_manifest
+from rpr3gen.model import LEGS, Model
+from rpr3gen.policy import invalid_samples
+from rpr3gen.trajectory import Trajectory
+
+__all__ = [
+    "JOINT_FAMILIES",
+    "RESULT_COLUMNS",
+    "SweepPlan",
+    "evaluate_chunk",
+    "result_columns",
+]
+
+JOINT_FAMILIES: tuple[str, ...] = ("f10x", "f10y", "f21y", "m21", "f32y", "f32z")
+"""Joint-load families whose peak a sweep reports as ``peak_<family>`` (docs/conventions.md)."""
+
+RESULT_COLUMNS: tuple[str, ...] = (
+    "feasible",
+    "reason",
+    *(f"peak_tau_{leg}" for leg in LEGS),
+    *(f"rms_tau_{leg}" for leg in LEGS),
+    "min_conditioning",
+    "workspace_area",
+    *(f"peak_{family}" for family in JOINT_FAMILIES),
+)
+"""The columns after the grid's keys, in order: the interface's, then ``peak_<family>``."""
+
+#: Samples per generated call when computing areas (designs x grid points).
+_AREA_BLOCK = 4 * BLOCK
+
+
+@dataclass(frozen=True)
+class SweepPlan:
+    """Everything a worker needs to evaluate any chunk of a sweep (picklable).
+
+    Attributes:
+        base: the base model's data (parsed TOML).
+        base_source: its name, for messages.
+        grid: the designs.
+        names: the trajectories' names, for the reasons.
+        trajectories: the trajectories, in the order given.
+        min_conditioning: the least conditioning of a feasible pose.
+        area_resolution: grid points per axis of the workspace area (0: no area, NaN).
+        chunk_size: designs per chunk.
+    """
+
+    base: dict[str, Any]
+    base_source: str
+    grid: Grid
+    names: tuple[str, ...]
+    trajectories: tuple[Trajectory, ...]
+    min_conditioning: float
+    area_resolution: int
+    chunk_size: int
+
+    @property
+    def chunks(self) -> int:
+        """Number of chunks."""
+        return -(-len(self.grid) // self.chunk_size)
+
+    def chunk(self, index: int) -> range:
+        """The designs of chunk ``index``."""
+        start = index * self.chunk_size
+        return range(start, min(start + self.chunk_size, len(self.grid)))
+
+
+def result_columns(grid: Grid) -> tuple[str, ...]:
+    """Every column of a sweep's output, in order: the grid's keys, then :data:`RESULT_COLUMNS`."""
+    return (*grid.keys, *RESULT_COLUMNS)
+
+
+def evaluate_chunk(plan: SweepPlan, index: int) -> tuple[int, dict[str, Any]]:
+    """Evaluate chunk ``index`` of ``plan``: ``(index, {column: values})``, one row per design.
+
+    The columns are :func:`result_columns`: float64 arrays, ``feasible`` bool, ``reason`` (and
+    ``actuation`` when varied) object arrays of text. A design whose values make an invalid
+    model is infeasible, its reason the model's error, its numbers NaN.
+    """
+    designs = plan.chunk(index)
+    n = len(designs)
+    columns: dict[str, Any] = plan.grid.columns(designs.start, designs.stop)
+    results: dict[str, Any] = {name: np.full(n, np.nan) for name in RESULT_COLUMNS}
+    results["feasible"] = np.zeros(n, dtype=bool)
+    results["reason"] = np.full(n, "", dtype=object)
+    groups: dict[str, list[tuple[int, Model]]] = {}
+    for k, design in enumerate(designs):
+        try:
+            model = design_model(plan.grid, plan.base, design, plan.base_source)
+        except ModelError as exc:
+            results["reason"][k] = f"invalid model: {exc}"
+            continue
+        groups.setdefault(model.actuation, []).append((k, model))
+    for actuation in sorted(groups):
+        rows = np.array([k for k, _ in groups[actuation]])
+        models = [m for _, m in groups[actuation]]
+        _trajectory_metrics(plan, models, rows, results)
+        if plan.area_resolution:
+            results["workspace_area"][rows] = workspace_areas(
+                models, plan.area_resolution, plan.min_conditioning
+            )
+    columns.update(results)
+    return index, columns
+
+
+def _samples(plan: SweepPlan) -> tuple[np.ndarray, ...]:
+    """Every trajectory's samples one after the other: q, qd, qdd (S, 3), the trajectory of
+    each sample (S,), its time (S,) and its time weight (S,), the trapezoid rule's."""
+    weights = []
+    for traj in plan.trajectories:
+        if len(traj) == 1:
+            weights.append(np.ones(1))
+            continue
+        dt = np.diff(traj.t)
+        weights.append(np.concatenate([[dt[0]], dt[1:] + dt[:-1], [dt[-1]]]) / 2)
+    which = np.concatenate([np.full(len(tr), i) for i, tr in enumerate(plan.trajectories)])
+    return (
+        np.concatenate([tr.q for tr in plan.trajectories]),
+        np.concatenate([tr.qd for tr in plan.trajectories]),
+        np.concatenate([tr.qdd for tr in plan.trajectories]),
+        which,
+        np.concatenate([tr.t for tr in plan.trajectories]),
+        np.concatenate(weights),
+    )
+
+
+def _trajectory_metrics(
+    plan: SweepPlan, models: Sequence[Model], rows: np.ndarray, results: dict[str, Any]
+) -> None:
+    """Fill the trajectory columns of ``results`` at ``rows`` for ``models`` (one actuation)."""
+    q, qd, qdd, which, t, weight = _samples(plan)
+    S = q.shape[0]
+    params = param_rows(models)
+    strokes = np.array([design_stroke(m) for m in models])  # (D, 3, 2)
+    effort = "m10" if models[0].actuation == "revolute" else "f21z"
+    per_call = max(1, BLOCK // S)
+    for lo in range(0, len(models), per_call):
+        hi = min(lo + per_call, len(models))
+        k = hi - lo
+        found = evaluate_stacked(
+            models[0],
+            "inverse_dynamics",
+            np.repeat(params[:, lo:hi], S, axis=1),
+            [np.tile(q, (k, 1)), np.tile(qd, (k, 1)), np.tile(qdd, (k, 1))],
+        )
+        ok = found.ok().reshape(k, S)
+        get = _blanked(found.values, ok)
+
+        conditioning = get("conditioning")
+        lambda21 = np.stack([get(f"lambda21_{leg}") for leg in LEGS], axis=2)
+        valid = within(
+            ok.ravel(),
+            conditioning.ravel(),
+            lambda21.reshape(-1, 3),
+            np.repeat(strokes[lo:hi], S, axis=0),
+            plan.min_conditioning,
+        ).reshape(k, S)
+        at = rows[lo:hi]
+        results["feasible"][at] = valid.all(axis=1)
+        raw = found["conditioning"].reshape(k, S)
+        results["min_conditioning"][at] = _least(np.where(np.isfinite(raw), raw, np.inf))
+        w = np.where(ok, weight, 0.0)
+        total = w.sum(axis=1)
+        for leg in LEGS:
+            tau = get(f"{effort}_{leg}")
+            results[f"peak_tau_{leg}"][at] = _peak(tau)
+            power = np.where(ok, tau, 0.0) ** 2
+            with np.errstate(invalid="ignore", divide="ignore"):
+                results[f"rms_tau_{leg}"][at] = np.sqrt((power * w).sum(axis=1) / total)
+        for family in JOINT_FAMILIES:
+            loads = np.concatenate([get(f"{family}_{leg}") for leg in LEGS], axis=1)
+            results[f"peak_{family}"][at] = _peak(loads)
+        for j in map(int, np.flatnonzero(~valid.all(axis=1))):
+            model = dataclasses.replace(models[lo + j], stroke=design_stroke(models[lo + j]))
+            results["reason"][at[j]] = _reason(plan, model, which, t, q, conditioning[j],
+                                               lambda21[j])  # fmt: skip
+
+
+def _blanked(values: dict[str, np.ndarray], ok: np.ndarray) -> Callable[[str], np.ndarray]:
+    """``get(name)``: the output ``name`` as (designs, samples), NaN where not ``ok``."""
+
+    def get(name: str) -> np.ndarray:
+        return np.where(ok, values[name].reshape(ok.shape), np.nan)
+
+    return get
+
+
+def _peak(values: np.ndarray) -> np.ndarray:
+    """Per row, the largest ``|value|`` of the finite ones; NaN when none is."""
+    peak = np.where(np.isfinite(values), np.abs(values), -np.inf).max(axis=1)
+    return np.where(np.isfinite(peak), peak, np.nan)
+
+
+def _least(values: np.ndarray) -> np.ndarray:
+    least = values.min(axis=1)
+    return np.where(np.isfinite(least), least, np.nan)
+
+
+def _reason(
+    plan: SweepPlan,
+    model: Model,
+    which: np.ndarray,
+    t: np.ndarray,
+    q: np.ndarray,
+    conditioning: np.ndarray,
+    lambda21: np.ndarray,
+) -> str:
+    """``"<trajectory>: t = <time> s: <why>"`` for the first pose at fault of one design."""
+    thresholds = load_manifest(model.actuation, model.generated).thresholds
+    for i, name in enumerate(plan.names):
+        at = which == i
+        out = {"conditioning": conditioning[at]}
+        for k, leg in enumerate(LEGS):
+            out[f"lambda21_{leg}"] = lambda21[at, k]
+        invalid = invalid_samples(model, q[at], out, plan.min_conditioning, thresholds)
+        if invalid is not None:
+            return f"{name}: t = {t[at][invalid.first]:.6g} s: {invalid.reason}"
+    return ""
+
+
+def workspace_areas(
+    models: Sequence[Model], resolution: int, min_conditioning: float
+) -> np.ndarray:
+    """The reachable area (m²) at ``phi = 0`` of each model (one actuation), on a grid of
+    ``resolution`` x ``resolution`` cells over the box of :func:`pose_extent`, as
+    :func:`rpr3gen.workspace` counts it."""
+    params = param_rows(models)
+    strokes = np.array([design_stroke(m) for m in models])
+    x0, x1, y0, y1 = pose_extent(params, 0.0, strokes[:, :, 1])
+    areas = np.zeros(len(models))
+    cells = resolution * resolution
+    per_call = max(1, _AREA_BLOCK // cells)
+    todo = np.flatnonzero((x0 < x1) & (y0 < y1))
+    for lo in range(0, todo.size, per_call):
+        d = todo[lo : lo + per_call]
+        xs = np.stack([cell_centres(x0[i], x1[i], resolution) for i in d])
+        ys = np.stack([cell_centres(y0[i], y1[i], resolution) for i in d])
+        xx = np.broadcast_to(xs[:, np.newaxis, :], (d.size, resolution, resolution))
+        yy = np.broadcast_to(ys[:, :, np.newaxis], (d.size, resolution, resolution))
+        q = np.column_stack([xx.ravel(), yy.ravel(), np.zeros(d.size * cells)])
+        ok = reachable(
+            models[0],
+            np.repeat(params[:, d], cells, axis=1),
+            q,
+            np.repeat(strokes[d], cells, axis=0),
+            min_conditioning,
+        ).reshape(d.size, cells)
+        cell = (x1[d] - x0[d]) / resolution * ((y1[d] - y0[d]) / resolution)
+        areas[d] = np.count_nonzero(ok, axis=1) * cell
+    return areas

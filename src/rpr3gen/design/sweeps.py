@@ -1,0 +1,325 @@
+"""Parameter sweeps: every design of a grid over the given trajectories, on Dask, as Parquet.
+
+The designs are cut into chunks of ``chunk_size`` in the grid's order; each chunk is one task
+(:func:`rpr3gen.design.metrics.evaluate_chunk`). Tasks run on a Dask cluster (a local one on
+this machine's cores by default, or the scheduler at ``scheduler``) or, with ``workers=0``, in
+this process (:mod:`rpr3gen.design.cluster`). The client writes each finished chunk as
+``OUT.parts/chunk-NNNNNN.parquet`` (atomically) as it arrives, so an interrupted sweep resumes
+(``resume=True``) from the chunks done; at the end the chunks are joined, in order, into ``OUT``
+(atomically) and the parts folder is removed. The chunks, and so the output's bytes, do not
+depend on the number of workers.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import shutil
+from collections.abc import Iterable, Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from rpr3gen import manifest
+from rpr3gen.design.cluster import run_chunks
+from rpr3gen.design.grid import read_grid
+from rpr3gen.design.metrics import SweepPlan, evaluate_chunk
+from rpr3gen.errors import (
+    InputError,
+    InputTypeError,
+    Rpr3genError,
+    TrajectoryError,
+    did_you_mean,
+)
+from rpr3gen.model import ACTUATIONS, model_from_dict, read_model_data
+from rpr3gen.policy import DEFAULT_MIN_CONDITIONING
+from rpr3gen.trajectory import (
+    DEFAULT_DURATION,
+    DEFAULT_SAMPLES,
+    PAPER_TRAJECTORIES,
+    Trajectory,
+    paper_trajectory,
+)
+
+__all__ = [
+    "DEFAULT_AREA_RESOLUTION",
+    "DEFAULT_CHUNK_SIZE",
+    "DEFAULT_TRAJECTORIES",
+    "parts_folder",
+    "sweep",
+]
+
+DEFAULT_CHUNK_SIZE = 64
+"""Designs per chunk (one Dask task, one part file)."""
+
+DEFAULT_AREA_RESOLUTION = 48
+"""Grid points per axis of each design's workspace area at ``phi = 0``."""
+
+DEFAULT_TRAJECTORIES: tuple[str, ...] = tuple(PAPER_TRAJECTORIES)
+"""The paper's two motions."""
+
+_PLAN_FILE = "sweep.json"
+_FORMAT = 1
+
+Columns = dict[str, Any]
+
+
+def parts_folder(out: str | os.PathLike[str]) -> Path:
+    """Where a sweep writing ``out`` keeps its finished chunks: ``out`` + ``.parts``."""
+    return Path(f"{os.fspath(out)}.parts")
+
+
+def sweep(
+    model: str | os.PathLike[str] | Mapping[str, Any] | None = None,
+    grid: str | os.PathLike[str] | Mapping[str, Any] | None = None,
+    trajectories: Sequence[str | os.PathLike[str] | Trajectory] = DEFAULT_TRAJECTORIES,
+    *,
+    out: str | os.PathLike[str] | None = None,
+    scheduler: str | None = None,
+    workers: int | None = None,
+    resume: bool = False,
+    chunk_size: int = DEFAULT_CHUNK_SIZE,
+    min_conditioning: float = DEFAULT_MIN_CONDITIONING,
+    area_resolution: int = DEFAULT_AREA_RESOLUTION,
+    samples: int = DEFAULT_SAMPLES,
+    duration: float = DEFAULT_DURATION,
+    progress: bool = False,
+) -> Any:
+    """Evaluate every design of ``grid`` over ``trajectories``; one row per design.
+
+    Args:
+        model: the base model: a model file, its data as a mapping, or None for the paper's.
+        grid: the grid file (TOML), or its content as a mapping ``{dotted key: values}``
+            (:mod:`rpr3gen.design.grid`).
+        trajectories: ``"rotation"``, ``"rectilinear"``, trajectory CSV files or
+            :class:`~rpr3gen.Trajectory` objects (named ``"trajectory N"`` in the reasons).
+        out: write the result as Parquet there (and its chunks to ``out + ".parts"`` on the
+            way); None writes nothing.
+        scheduler: the address of a Dask scheduler (``"tcp://host:port"``) to run on; None
+            starts a local cluster.
+        workers: processes of the local cluster (None: this machine's cores); 0 runs in this
+            process without Dask.
+        resume: continue the sweep whose chunks are in ``out + ".parts"``.
+        chunk_size: designs per task.
+        min_conditioning: the least conditioning of a feasible pose, in [0, 1).
+        area_resolution: grid points per axis of the workspace area (0: no area).
+        samples, duration: of the paper trajectories.
+        progress: show a progress bar on stderr when it is a terminal.
+
+    Returns:
+        A :class:`pyarrow.Table`: the grid's keys, then
+        :data:`rpr3gen.design.metrics.RESULT_COLUMNS`, rows in the grid's order.
+
+    Raises:
+        ModelError, GridError, TrajectoryError, InputError: bad input, before any work.
+        Rpr3genError: an interrupted sweep's chunks are in the way (without ``resume``), or
+            they belong to another sweep.
+    """
+    plan = make_plan(model, grid, trajectories, chunk_size=chunk_size,
+                     min_conditioning=min_conditioning, area_resolution=area_resolution,
+                     samples=samples, duration=duration)  # fmt: skip
+    _check_workers(workers)
+    if out is None:
+        if resume:
+            raise InputError("resume: needs out, the file whose chunks are resumed")
+        parts: dict[int, Columns] = {}
+        run_chunks(plan, range(plan.chunks), evaluate_chunk, parts.__setitem__, scheduler, workers,
+                   progress)  # fmt: skip
+        return _joined(_table(parts[i]) for i in range(plan.chunks))
+    from rpr3gen.design import parquet
+
+    target = Path(out)
+    _check_destination(target)
+    folder = _open_parts(plan, parts_folder(target), resume)
+
+    def keep(index: int, columns: Columns) -> None:
+        parquet.write_table(folder / _part_name(index), _table(columns))
+
+    done = _done_chunks(plan, folder)
+    todo = [i for i in range(plan.chunks) if i not in done]
+    initial = sum(len(plan.chunk(i)) for i in done)
+    try:
+        run_chunks(plan, todo, evaluate_chunk, keep, scheduler, workers, progress, initial=initial)
+    except Rpr3genError as exc:
+        raise Rpr3genError(f"{exc}; the chunks done are in {folder}: rerun with --resume") from exc
+    target.parent.mkdir(parents=True, exist_ok=True)
+    parquet.write_tables(target, (folder / _part_name(i) for i in range(plan.chunks)))
+    shutil.rmtree(folder)
+    return parquet.read_table(target)
+
+
+def make_plan(
+    model: str | os.PathLike[str] | Mapping[str, Any] | None,
+    grid: str | os.PathLike[str] | Mapping[str, Any] | None,
+    trajectories: Sequence[str | os.PathLike[str] | Trajectory],
+    *,
+    chunk_size: int = DEFAULT_CHUNK_SIZE,
+    min_conditioning: float = DEFAULT_MIN_CONDITIONING,
+    area_resolution: int = DEFAULT_AREA_RESOLUTION,
+    samples: int = DEFAULT_SAMPLES,
+    duration: float = DEFAULT_DURATION,
+) -> SweepPlan:
+    """Check every input and build the :class:`SweepPlan` (no work yet)."""
+    if grid is None:
+        raise InputError("grid: give a grid file or a mapping {dotted model key: values}")
+    _positive_int("chunk_size", chunk_size, least=1)
+    _positive_int("area_resolution", area_resolution, least=0)
+    if area_resolution == 1:
+        raise InputError("area_resolution: must be 0 (no area) or an integer >= 2, got 1")
+    if not 0.0 <= min_conditioning < 1.0:
+        raise InputError(f"min_conditioning: must be in [0, 1), got {min_conditioning!r}")
+    if isinstance(model, Mapping):
+        source, base = "<model>", dict(model)
+    else:
+        source, base = read_model_data(model)
+    model_from_dict(base, source=source)  # the base itself must be valid
+    checked = read_grid(grid, base)
+    names, trajs = _trajectories(trajectories, samples, duration)
+    return SweepPlan(
+        base=base,
+        base_source=source,
+        grid=checked,
+        names=names,
+        trajectories=trajs,
+        min_conditioning=float(min_conditioning),
+        area_resolution=int(area_resolution),
+        chunk_size=int(chunk_size),
+    )
+
+
+def _positive_int(name: str, value: Any, least: int) -> None:
+    if isinstance(value, bool) or not isinstance(value, int | np.integer):
+        raise InputTypeError(f"{name}: must be an integer >= {least}, got {value!r}")
+    if value < least:
+        raise InputError(f"{name}: must be an integer >= {least}, got {value!r}")
+
+
+def _check_workers(workers: int | None) -> None:
+    if workers is not None:
+        _positive_int("workers", workers, least=0)
+
+
+def _trajectories(
+    given: Sequence[str | os.PathLike[str] | Trajectory], samples: int, duration: float
+) -> tuple[tuple[str, ...], tuple[Trajectory, ...]]:
+    from rpr3gen.trajectory import read_trajectory_csv
+
+    if isinstance(given, str | os.PathLike | Trajectory) or not given:
+        raise InputError("trajectories: give a non-empty list of trajectories")
+    names, trajs = [], []
+    for i, item in enumerate(given):
+        if isinstance(item, Trajectory):
+            names.append(f"trajectory {i + 1}")
+            trajs.append(item)
+        elif isinstance(item, str) and item in PAPER_TRAJECTORIES:
+            names.append(item)
+            trajs.append(paper_trajectory(item, samples=samples, duration=duration))
+        else:
+            path = Path(item)
+            if path.suffix.lower() != ".csv" and not path.exists():
+                hint = did_you_mean(str(item), PAPER_TRAJECTORIES)
+                raise TrajectoryError(
+                    f"--trajectory: {os.fspath(item)!r} is neither "
+                    f"{', '.join(PAPER_TRAJECTORIES)} nor a CSV file{hint}"
+                )
+            names.append(path.stem)
+            trajs.append(read_trajectory_csv(path))
+    return tuple(names), tuple(trajs)
+
+
+def identity(plan: SweepPlan) -> str:
+    """A hash of everything that decides a sweep's results (SHA-256, hex): the base model, the
+    grid, the trajectories, the options, the chunking, the runtime's version and the generated
+    code's."""
+    from rpr3gen import __version__
+
+    digest = hashlib.sha256()
+    for traj in plan.trajectories:
+        for array in (traj.t, traj.q, traj.qd, traj.qdd):
+            digest.update(np.ascontiguousarray(array).tobytes())
+    described = {
+        "format": _FORMAT,
+        "base": plan.base,
+        "grid": plan.grid.as_dict(),
+        "trajectories": list(plan.names),
+        "samples": digest.hexdigest(),
+        "min_conditioning": plan.min_conditioning,
+        "area_resolution": plan.area_resolution,
+        "chunk_size": plan.chunk_size,
+        "rpr3gen": __version__,
+        "generated": {a: manifest.load(a).source_hash for a in ACTUATIONS},
+    }
+    text = json.dumps(described, sort_keys=True, default=str)
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+def _check_destination(target: Path) -> None:
+    if target.is_dir():
+        raise Rpr3genError(f"{target}: cannot write the sweep: it is a folder")
+    for part in target.parents:
+        if part.exists():
+            if not part.is_dir():
+                raise Rpr3genError(f"{target}: cannot write the sweep: {part} is a file")
+            return
+
+
+def _open_parts(plan: SweepPlan, folder: Path, resume: bool) -> Path:
+    """The parts folder, made or checked: it must be this sweep's to resume it."""
+    stamp = {"identity": identity(plan), "designs": len(plan.grid), "chunks": plan.chunks}
+    if folder.exists():
+        if not resume:
+            raise Rpr3genError(
+                f"{folder}: holds the chunks of an interrupted sweep; pass --resume "
+                "(resume=True) to continue it, or remove the folder"
+            )
+        try:
+            found = json.loads((folder / _PLAN_FILE).read_text(encoding="utf-8"))
+        except (OSError, ValueError):
+            found = None
+        if found != stamp:
+            raise Rpr3genError(
+                f"{folder}: holds the chunks of another sweep (other model, grid, "
+                "trajectories, options or version); remove it to start this one"
+            )
+        return folder
+    folder.mkdir(parents=True)
+    from rpr3gen.atomic import atomic_write
+
+    with atomic_write(folder / _PLAN_FILE) as f:
+        json.dump(stamp, f, sort_keys=True)
+    return folder
+
+
+def _part_name(index: int) -> str:
+    return f"chunk-{index:06d}.parquet"
+
+
+def _done_chunks(plan: SweepPlan, folder: Path) -> set[int]:
+    """The chunks whose part file is there, whole (its rows all there)."""
+    import pyarrow.parquet as pq
+
+    done = set()
+    for index in range(plan.chunks):
+        path = folder / _part_name(index)
+        if path.is_file():
+            try:
+                rows = pq.read_metadata(path).num_rows
+            except (OSError, ValueError):
+                continue
+            if rows == len(plan.chunk(index)):
+                done.add(index)
+    return done
+
+
+def _table(columns: Columns) -> Any:
+    from rpr3gen.design.parquet import to_table
+
+    return to_table(columns)
+
+
+def _joined(tables: Iterable[Any]) -> Any:
+    import pyarrow as pa
+
+    return pa.concat_tables(list(tables)).combine_chunks()
