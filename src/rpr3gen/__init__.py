@@ -30,8 +30,8 @@ from rpr3gen.control import (
 )
 from rpr3gen.design import WorkspaceMap, sweep, workspace, write_workspace
 from rpr3gen.errors import (
-    IdentificationError,
     GridError,
+    IdentificationError,
     InputError,
     InputTypeError,
     ModelError,
@@ -64,8 +64,8 @@ __all__ = [
     "INERTIAL_PARAMETER_NAMES",
     "OUTPUT_NAMES",
     "PARAM_NAMES",
-    "IdentificationError",
     "GridError",
+    "IdentificationError",
     "InputError",
     "InputTypeError",
     "Model",
