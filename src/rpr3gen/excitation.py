@@ -189,6 +189,10 @@ def excite(
     def at(u: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         return _at(np.asarray(u, dtype=float).tobytes())
 
+    # The best feasible point the optimiser has evaluated: SLSQP can end (or stop at its
+    # iteration limit) outside the constraints, or fail its line search far from the start.
+    best_value, best_u = math.inf, np.zeros(0)
+
     def log_cond(u: np.ndarray) -> float:
         W = at(u)[0]
         if not np.isfinite(W).all():
@@ -198,7 +202,11 @@ def excite(
             return 80.0
         # cond(W) = cond(R) of W = QR: the small R's singular values cost far less.
         s = np.linalg.svd(np.linalg.qr(W / norms, mode="r"), compute_uv=False)
-        return float(np.log(s[0] / s[-1])) if s[-1] > 0 else 80.0
+        value = float(np.log(s[0] / s[-1])) if s[-1] > 0 else 80.0
+        nonlocal best_value, best_u
+        if value < best_value and constraints(u).min() >= 0:
+            best_value, best_u = value, np.array(u, dtype=float)
+        return value
 
     def constraints(u: np.ndarray) -> np.ndarray:
         _, out, codes, qdd = at(u)
@@ -236,17 +244,16 @@ def excite(
         constraints=[{"type": "ineq", "fun": lambda u: constraints(u) - margin}],
         options={"maxiter": max_iterations, "ftol": 1e-6},
     )
-    best = result.x if constraints(result.x).min() >= 0 else start
-    if log_cond(best) > log_cond(start):
-        best = start
-    found = motion(best)
+    log_cond(result.x)  # counted as a candidate if it keeps the constraints
+    chosen = best_u if best_u.size else start
+    found = motion(chosen)
     traj = found.trajectory(samples)
     (out,), _ = evaluate(model, "inverse_dynamics", (traj.q, traj.qd, traj.qdd))
     lam = out[:, [names[f"lambda21_{leg}"] for leg in LEGS]]
     return Excitation(
         motion=found,
         trajectory=traj,
-        condition_number=math.exp(log_cond(best)),
+        condition_number=math.exp(log_cond(chosen)),
         initial_condition_number=initial,
         iterations=int(result.nit),
         min_conditioning=float(out[:, names["conditioning"]].min()),
