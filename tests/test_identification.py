@@ -299,11 +299,14 @@ def test_bad_samples_are_named() -> None:
 # Exciting trajectories.
 
 
-def test_excite_lowers_the_condition_number_inside_the_workspace() -> None:
+@pytest.mark.parametrize("identical", [False, True], ids=["per-leg", "identical-legs"])
+def test_excite_lowers_the_condition_number_inside_the_workspace(identical: bool) -> None:
     """The optimised motion is better conditioned than the start and than the limit, and keeps
     every constraint, checked with the inverse dynamics (not the optimiser's own values)."""
     model = rpr3gen.load_model()
-    found = rpr3gen.excite(model, harmonics=3, period=6.0, samples=61, max_iterations=25)
+    found = rpr3gen.excite(
+        model, harmonics=3, period=6.0, samples=61, max_iterations=25, identical_legs=identical
+    )
     assert found.condition_number < found.initial_condition_number / 3
     assert found.condition_number < idn.MAX_CONDITION
     traj = found.trajectory
@@ -317,7 +320,7 @@ def test_excite_lowers_the_condition_number_inside_the_workspace() -> None:
     np.testing.assert_allclose(traj.q[0], traj.q[-1], atol=1e-12)
     # And the identification it was made for works on it.
     tau = rpr3gen.actuator_efforts(model, traj.q, traj.qd, traj.qdd)
-    fit = rpr3gen.identify(model, traj.q, traj.qd, traj.qdd, tau)
+    fit = rpr3gen.identify(model, traj.q, traj.qd, traj.qdd, tau, identical_legs=identical)
     assert math.isclose(fit.condition_number, found.condition_number, rel_tol=1e-6)
 
 
