@@ -3,7 +3,7 @@
 ``tests/c_math_kernels.c`` includes the generated source and compares every kernel with the C
 library: dense sweeps, neighbours of multiples of pi/2, every binade (subnormals too), uniform
 bit patterns (mostly huge arguments, through the Payne-Hanek reduction) and every pair of special
-values. The documented accuracy (derive/codegen/backends/c/mathkernels.py) is what is asserted.
+values. The documented accuracy (derive/codegen/mathkernels.py) is what is asserted.
 A few hard arguments are checked against mpmath's correctly rounded values instead, where the
 C library itself is off (glibc's cos of the hardest double for reduction is 8 ulp off).
 """
@@ -87,7 +87,7 @@ def test_hard_arguments_against_mpmath(harness: Path) -> None:
 
 
 def test_polynomials_are_the_remez_fits() -> None:
-    from rpr3gen_derive.codegen.backends.c import mathkernels, minimax
+    from rpr3gen_derive.codegen import mathkernels, minimax
 
     fits = minimax.fits()
     for name, table in (("sin", mathkernels.SIN), ("cos", mathkernels.COS),

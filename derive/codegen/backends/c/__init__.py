@@ -4,8 +4,9 @@ Per function ``f`` of a module with prefix ``p``: ``int p_f(params, inputs..., o
 one sample (outputs untouched unless it returns ``P_OK``) and ``size_t p_f_batch(params, n,
 inputs..., outputs...)`` over n row-major samples, evaluated in three passes so that the
 compiler vectorises them (:mod:`.batch`). Both run the same statements and the same math
-kernels (:mod:`.mathkernels`); a batch sample that fails a check, or whose ``sin``/``cos``
-argument is beyond the kernels' fast path, is evaluated again by the single-sample kernel.
+kernels (:mod:`rpr3gen_derive.codegen.mathkernels`); a batch sample that fails a check, or
+whose ``sin``/``cos`` argument is beyond the kernels' fast path, is evaluated again by the
+single-sample kernel.
 """
 
 from __future__ import annotations
@@ -13,7 +14,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 import jinja2
-from rpr3gen_derive.codegen.backends.c import mathkernels
+from rpr3gen_derive.codegen import mathkernels
 from rpr3gen_derive.codegen.backends.c.batch import NotSplittableError, plan
 from rpr3gen_derive.codegen.backends.c.printer import c_code, fast_trig_arguments
 from rpr3gen_derive.codegen.spec import ModuleSpec

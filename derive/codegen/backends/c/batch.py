@@ -2,9 +2,9 @@
 
 A call into libm keeps a loop scalar. The generated C has kernels of its own for everything the
 derivations use (``sin``, ``cos``, ``atan2``, ``Min``, ``Max``, the rounding of ``wrap_angle``:
-:mod:`.mathkernels`; ``sqrt`` and ``fabs`` are instructions), so with them every statement
-vectorises; any other call (``exp``, ``pow``...) would not. The batch function therefore
-evaluates a block of samples in three passes:
+:mod:`rpr3gen_derive.codegen.mathkernels`; ``sqrt`` and ``fabs`` are instructions), so with
+them every statement vectorises; any other call (``exp``, ``pow``...) would not. The batch
+function therefore evaluates a block of samples in three passes:
 
 A. scalar, per sample: the inputs, and the statements that call libm early and what they depend
    on (none, with the kernels); their results go to block arrays;

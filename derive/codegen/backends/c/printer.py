@@ -3,10 +3,11 @@
 Squares and small integer powers are expanded to products by SymPy's rewriting passes before
 printing (:func:`rpr3gen_derive.codegen.backends.prepare`), so no ``pow`` is emitted for them.
 ``sin``, ``cos``, ``atan2``, ``Min``, ``Max`` and the rounding of ``wrap_angle`` are printed as
-calls of the generated C's own inline kernels (:mod:`.mathkernels`), ``{prefix}_sin`` etc., so
-that loops over samples vectorise. In the batch loops (``fast=True``) ``sin`` and ``cos`` are
-the kernels' fast path (``{prefix}_sin_fast``), valid below ``mathkernels.FAST_LIMIT``; the
-batch flags larger arguments (:func:`fast_trig_arguments`).
+calls of the generated C's own inline kernels (:mod:`rpr3gen_derive.codegen.mathkernels`),
+``{prefix}_sin`` etc., so that loops over samples vectorise. In the batch loops
+(``fast=True``) ``sin`` and ``cos`` are the kernels' fast path (``{prefix}_sin_fast``), valid
+below ``mathkernels.FAST_LIMIT``; the batch flags larger arguments
+(:func:`fast_trig_arguments`).
 """
 
 from __future__ import annotations

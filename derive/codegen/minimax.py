@@ -1,4 +1,4 @@
-"""Minimax polynomials of the C math kernels (:mod:`.mathkernels`), by the Remez exchange.
+"""Minimax polynomials of the math kernels (:mod:`.mathkernels`), by the Remez exchange.
 
 The generated C evaluates ``sin``, ``cos`` and ``atan2`` with its own branch-free kernels so that
 the compiler can vectorise the batch loops (glibc's ``sin`` may set ``errno`` and is never
@@ -9,7 +9,7 @@ relative error, of degree n in ``z = r**2`` on the kernels' reduced intervals:
 - ``cos(r) = 1 - z/2 + z**2 C(z)`` on ``|r| <= pi/4``;
 - ``atan(t) = t + t**3 A(z)`` on ``0 <= t <= tan(pi/8)``.
 
-Run ``python -m rpr3gen_derive.codegen.backends.c.minimax`` to recompute them (mpmath, 50
+Run ``python -m rpr3gen_derive.codegen.minimax`` to recompute them (mpmath, 50
 digits); :mod:`.mathkernels` holds the result, rounded to double, and a test checks that the two
 agree. Nothing here runs at generation time.
 """
