@@ -27,11 +27,35 @@ _UFUNC = {sp.cos: "cos", sp.sin: "sin", sp.Abs: "absolute", sp.atan2: "arctan2"}
 
 @dataclass
 class LoweredNumpy:
-    """Lines of the generated function body, and the size of its work array."""
+    """Lines of the generated function body, the size of its work array, and whether it calls
+    the module's ``_sincos`` helper."""
 
     scalar_lines: list[str]
     vector_lines: list[str]
     buffers: int
+    sincos: bool = False
+
+
+#: Work rows the module's ``_sincos(x, s, c, work)`` helper takes.
+SINCOS_WORK = 4
+
+
+def trig_pairs(statements: list[tuple[sp.Symbol, sp.Expr]]) -> dict[sp.Symbol, sp.Symbol]:
+    """``{first: second}`` for each ``s = sin(a)``, ``c = cos(a)`` pair of statements: evaluated
+    together by ``_sincos`` (NumPy's ``sin`` and ``cos`` cost ~10 ns a value each; the pair,
+    ~50 ufunc passes of the C kernels' reduction and polynomials, about half of that)."""
+    found: dict[tuple[type, sp.Expr], sp.Symbol] = {}
+    for lhs, rhs in statements:
+        if isinstance(rhs, (sp.sin, sp.cos)):
+            found.setdefault((type(rhs), rhs.args[0]), lhs)
+    pairs = {}
+    for (func, arg), lhs in found.items():
+        if func is sp.sin and (sp.cos, arg) in found:
+            other = found[(sp.cos, arg)]
+            order = [s for s, _ in statements]
+            first, second = sorted((lhs, other), key=order.index)
+            pairs[first] = second
+    return pairs
 
 
 @dataclass
@@ -276,14 +300,32 @@ def lower_numpy(
     state = _Lowering(scalars=set(params))
     state.location.update(inputs)
     scalar_lines: list[str] = []
+    rhs_of = dict(statements)
+    pairs = {
+        a: b
+        for a, b in trig_pairs(statements).items()
+        if a not in alias and b not in alias and not state.is_scalar(rhs_of[a])
+    }
     for index, (lhs, rhs) in enumerate(statements):
         if state.is_scalar(rhs):
             state.scalars.add(lhs)
             scalar_lines.append(f"{lhs} = {numpy_code(rhs)}")
             continue
-        target = alias.get(lhs)
-        result = state.emit(rhs, target)
-        state.bind(lhs, result)
+        if lhs in pairs:  # sin and cos of one argument, both now
+            second = pairs[lhs]
+            x = state.emit(rhs.args[0])
+            rows = {type(rhs): state.new(), type(rhs_of[second]): state.new()}
+            work = [state.new() for _ in range(SINCOS_WORK)]
+            state.lines.append(
+                f"_sincos({x}, {rows[sp.sin]}, {rows[sp.cos]}, ({', '.join(work)},))"
+            )
+            for operand in (x, *work):
+                state.release(operand)
+            state.bind(lhs, rows[type(rhs)])
+            state.bind(second, rows[type(rhs_of[second])])
+        elif lhs not in pairs.values():
+            target = alias.get(lhs)
+            state.bind(lhs, state.emit(rhs, target))
         for sym in rhs.free_symbols:  # operands whose last use is this statement
             if uses.get(sym) == index:
                 state.drop(sym)
@@ -294,4 +336,4 @@ def lower_numpy(
         if expr.is_Symbol and alias.get(expr) == row:
             continue
         state.emit(expr, row)
-    return LoweredNumpy(scalar_lines, state.lines, state.count)
+    return LoweredNumpy(scalar_lines, state.lines, state.count, bool(pairs))
