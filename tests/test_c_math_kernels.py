@@ -94,3 +94,14 @@ def test_polynomials_are_the_remez_fits() -> None:
                         ("atan", mathkernels.ATAN)):  # fmt: skip
         assert fits[name].error < 2.0**-56, name  # below half an ulp: the rounding dominates
         assert np.allclose(fits[name].coefficients, table, rtol=1e-12, atol=0.0), name
+
+
+def test_estrin_is_the_polynomial() -> None:
+    from rpr3gen_derive.codegen import mathkernels
+
+    for coefficients in (mathkernels.SIN, mathkernels.ATAN, (1.0, 2.0, 3.0)):
+        text = mathkernels.estrin(coefficients, "z")  # C, and Python too: numbers, +, *, ()
+        for z in (0.0, 0.3, -0.7, 1.5):
+            scope = {"z": z, **{f"z{p}": z**p for p in mathkernels.powers(len(coefficients))}}
+            want = sum(c * z**k for k, c in enumerate(coefficients))
+            assert eval(text, scope) == pytest.approx(want, rel=1e-14, abs=1e-300)

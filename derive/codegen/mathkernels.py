@@ -103,6 +103,36 @@ def horner(coefficients: Iterable[float], variable: str) -> str:
     return text
 
 
+def estrin(coefficients: Iterable[float], variable: str) -> str:
+    """``sum c_k z^k`` in C by Estrin's scheme, with ``{variable}2``, ``{variable}4``... the
+    powers ``z^2``, ``z^4``... (which the caller defines): pairs ``c_2i + c_2i+1 z`` combined
+    by powers of ``z^2``, a dependency chain of log2(n) steps where Horner's is n, so a single
+    call waits less on the multiply-add latency."""
+    terms = [literal(c) for c in coefficients]
+    level = [
+        f"({terms[k]} + {variable} * {terms[k + 1]})" if k + 1 < len(terms) else terms[k]
+        for k in range(0, len(terms), 2)
+    ]
+    power = 2
+    while len(level) > 1:
+        level = [
+            f"({level[k]} + {variable}{power} * {level[k + 1]})" if k + 1 < len(level) else level[k]
+            for k in range(0, len(level), 2)
+        ]
+        power *= 2
+    return level[0]
+
+
+def powers(count: int) -> list[int]:
+    """The powers of z that :func:`estrin` uses for ``count`` coefficients: 2, 4, ..."""
+    found, power, width = [], 2, (count + 1) // 2
+    while width > 1:
+        found.append(power)
+        power *= 2
+        width = (width + 1) // 2
+    return found
+
+
 def used(exprs: Iterable[sp.Expr]) -> set[str]:
     """The kernels printing ``exprs`` needs: ``trig``, ``atan2``, ``rint``, ``minmax``."""
     found: set[str] = set()
@@ -123,9 +153,11 @@ def context(kernels: set[str]) -> dict[str, Any]:
     """What ``mathkernels.c.jinja`` renders, for the kernels in ``kernels``."""
     return {
         "kernels": kernels,
-        "sin_poly": horner(SIN, "z"),
-        "cos_poly": horner(COS, "z"),
-        "atan_poly": horner(ATAN, "z"),
+        "sin_poly": estrin(SIN, "z"),
+        "cos_poly": estrin(COS, "z"),
+        "trig_powers": powers(max(len(SIN), len(COS))),
+        "atan_poly": estrin(ATAN, "z"),
+        "atan_powers": powers(len(ATAN)),
         "fast_limit": FAST_LIMIT,
         "table": [f"{c}.0" for c in two_over_pi_chunks()],
         "table_size": TABLE_SIZE,
