@@ -9,6 +9,7 @@ out of another's (each NumPy size).
 from __future__ import annotations
 
 import contextlib
+import functools
 import json
 import os
 import resource
@@ -29,6 +30,7 @@ from rpr3bench.common import (
     sample_inputs,
     variant,
 )
+from rpr3bench.speedworkers import WORKERS as SPEED_WORKERS
 
 SHARED = "shared"  # the stages of regeneration outside any variant
 
@@ -327,7 +329,11 @@ def worker_lambdify(args: dict[str, Any]) -> dict[str, Any]:
     # (SymPy's, plus those) prints them. Everything else is plain lambdify.
     printer = NumpyPrinter()
     start = time.perf_counter()
-    func = sp.lambdify(arguments, expanded, modules="numpy", cse=False, printer=printer)
+    # SymPy's NumPy printer folds Min/Max with functools.reduce: the namespace needs functools.
+    func = sp.lambdify(
+        arguments, expanded, modules=[{"functools": functools}, "numpy"], cse=False,
+        printer=printer,
+    )  # fmt: skip
     t_lambdify = time.perf_counter() - start
     expanded_ops = sum(int(sp.count_ops(e)) for e in expanded)
 
@@ -349,12 +355,12 @@ def worker_lambdify(args: dict[str, Any]) -> dict[str, Any]:
         start = time.perf_counter()
         got = calls.backend(*inputs)
         t_gen.append(time.perf_counter() - start)
-    index = {o.name: k for k, o in enumerate(spec.outputs)}
+    index = {o.name: k for k, o in enumerate(spec.public_outputs)}  # evaluate() returns these
     lam = {
         f"{o}[{k}]": np.broadcast_to(np.asarray(value, dtype=float), (n,))
         for (o, k, _), value in zip(flat, result, strict=True)
     }
-    gen = {f"{o}[{k}]": got[index[o]][:, k] for o, k, _ in flat}
+    gen = {f"{o}[{k}]": got[index[o]][:, k] for o, k, _ in flat if o in index}
     worst, compared = _relative_difference(lam, gen)
     return {
         "function": name,
@@ -824,6 +830,7 @@ WORKERS: dict[str, Callable[[dict[str, Any]], dict[str, Any]]] = {
     "control_python": worker_control_python,
     "fk_iterations": worker_fk_iterations,
     "mujoco": worker_mujoco,
+    **SPEED_WORKERS,
 }
 
 
