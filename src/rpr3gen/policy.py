@@ -37,22 +37,12 @@ DEFAULT_MIN_CONDITIONING = 1e-3
 def finite_rows(array: np.ndarray) -> np.ndarray:
     """(n,) bool: every value of the row is finite, for an (n, k) array of either layout.
 
-    A row's sum is finite when its values are, and NaN or infinite when one is not: the sum,
-    one ufunc call per column, is the fast test (no BLAS: its threads are slower than the work
-    here); only the rows whose sum is not finite (also those of finite values whose sum
-    overflows, if any) are looked at value by value.
+    One pass over the values in memory order answers the usual case, all finite; only then is
+    each row looked at (``isfinite(...).all(axis=1)`` over rows of 3 would cost ten times more).
     """
-    if array.shape[1] == 0:
+    if np.isfinite(array).all():
         return np.ones(array.shape[0], dtype=bool)
-    total = array[:, 0].copy()
-    with np.errstate(invalid="ignore", over="ignore"):
-        for k in range(1, array.shape[1]):
-            np.add(total, array[:, k], out=total)
-    ok = np.isfinite(total)
-    suspects = ~ok
-    if suspects.any():
-        ok[suspects] = np.isfinite(array[suspects]).all(axis=1)
-    return ok
+    return np.isfinite(array.T).all(axis=0)
 
 
 def return_codes(
