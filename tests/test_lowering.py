@@ -174,3 +174,17 @@ def test_generated_sincos_is_within_two_ulp() -> None:
         sincos(x, s, c, [np.empty(2) for _ in range(4)])
     assert np.isnan([s[0], c[0]]).all()
     assert s[1] == np.sin(0.5)
+
+
+def test_scratch_rows_passed_in_give_the_same_bits() -> None:
+    import rpr3gen
+
+    module = _generated_numpy()
+    traj = rpr3gen.paper_trajectory("rotation", samples=50)
+    params = rpr3gen.load_model().vector(rpr3gen.PARAM_NAMES)
+    rows = module.WORK_ROWS["rpr3_inverse_dynamics"]
+    fresh, reused = np.empty((module.NUM_OUTPUTS, 50)), np.empty((module.NUM_OUTPUTS, 50))
+    module.rpr3_inverse_dynamics(params, traj.q, traj.qd, traj.qdd, fresh)
+    work = np.full((rows + 3, 80), np.nan)  # larger than needed, and dirty
+    module.rpr3_inverse_dynamics(params, traj.q, traj.qd, traj.qdd, reused, work=work)
+    assert fresh.tobytes() == reused.tobytes()

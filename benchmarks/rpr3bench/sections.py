@@ -593,7 +593,9 @@ def _newton_euler(quick: bool, numpy_results: dict[str, Any]) -> tuple[str, dict
         "(kinematics, an (n, 21, 21) system, one batched `numpy.linalg.solve`) interleaved "
         'with the NumPy backend `evaluate(model, "inverse_dynamics", (q, qd, qdd), '
         'backend="numpy")` and the generated function in one call, on the same samples in one '
-        f"process (best of {len(ne['sizes'][0]['ne'])}); the difference column compares the "
+        f"process (best of {len(ne['sizes'][0]['ne'])}; each timed right after an untimed run "
+        "of itself, so that each is measured warm and none just after the other's cache "
+        "footprint); the difference column compares the "
         f"{ne['sizes'][0]['compared']} outputs both give (backend against Newton–Euler, "
         "relative to max(1, |value|)). The parameters of `newton_euler.paper_params()` and of "
         f"`load_model()` differ by at most {ne['param_diff']:.1e}.\n"

@@ -285,13 +285,18 @@ def worker_newton_euler(args: dict[str, Any]) -> dict[str, Any]:
         outputs = calls.allocate(n)
         t_ne, t_np, t_direct = [], [], []
         ref, got = {}, {}
+        # Interleaved, each timed right after an untimed run of itself: every candidate is
+        # measured warm, none just after another one's cache footprint (NE's is ~35 MB at 10^4).
         for _ in range(int(args["repeats"])):
+            ne.solve(ne_params, VARIANT, q, qd, qdd)
             start = time.perf_counter()
             ref = ne.solve(ne_params, VARIANT, q, qd, qdd)
             t_ne.append(time.perf_counter() - start)
+            calls.backend(q, qd, qdd)
             start = time.perf_counter()
             got = calls.named(calls.backend(q, qd, qdd))
             t_np.append(time.perf_counter() - start)
+            calls.direct([q, qd, qdd], outputs)
             start = time.perf_counter()
             calls.direct([q, qd, qdd], outputs)
             t_direct.append(time.perf_counter() - start)

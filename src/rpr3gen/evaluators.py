@@ -106,7 +106,9 @@ def numpy_module(variant: Variant) -> ModuleType:
 class NumpyEvaluator:
     """The generated NumPy code; outputs are stored (size, n), so each output row is contiguous.
 
-    One thread: ``threads`` is accepted and ignored.
+    One thread: ``threads`` is accepted and ignored. The generated functions' scratch rows
+    (``work``) are one array per thread, kept between calls: fresh ones would cost mapping and
+    zeroing new pages at every block.
     """
 
     applies_checks = False
@@ -117,6 +119,17 @@ class NumpyEvaluator:
     def __init__(self, variant: Variant) -> None:
         self.variant = variant
         self.module = numpy_module(variant)
+        self._scratch = threading.local()
+
+    def _work(self, rows: int, n: int) -> np.ndarray | None:
+        """This thread's scratch array, at least ``rows`` x ``n`` (grown on demand)."""
+        if not rows:
+            return None
+        work = getattr(self._scratch, "work", None)
+        if work is None or work.shape[0] < rows or work.shape[1] < n:
+            shape = (rows, n) if work is None else (max(rows, work.shape[0]), max(n, work.shape[1]))
+            work = self._scratch.work = np.empty(shape)
+        return work
 
     def allocate(self, function: FunctionInfo, n: int) -> list[np.ndarray]:
         return [np.empty((o.size, n)).T for o in function.outputs]
@@ -135,7 +148,12 @@ class NumpyEvaluator:
                 "use backend='c'"
             )
         call = getattr(self.module, function.numpy_function)
-        call(params, *inputs, *(o.T for o in outputs))
+        rows = getattr(self.module, "WORK_ROWS", {}).get(function.numpy_function)
+        if rows is None:  # generated before the work argument
+            call(params, *inputs, *(o.T for o in outputs))
+        else:
+            work = self._work(rows, inputs[0].shape[0])
+            call(params, *inputs, *(o.T for o in outputs), work=work)
         return None
 
 
