@@ -1,9 +1,9 @@
 /* C timing harness of rpr3gen's generated inverse dynamics (run by benchmarks/run.py,
  * through benchmarks/rpr3bench/charness.py).
  *
- * Build (from the repository root), as the harness does:
- *   cc -std=c99 -O3 -march=native -I generated/revolute benchmarks/bench.c \
- *      generated/revolute/rpr3.c -lm -o bench
+ * Build (from the repository root), as the harness does (the runtime's flags):
+ *   cc -std=c99 -O3 -fno-math-errno -fno-trapping-math -march=native -mno-fma \
+ *      -I generated/revolute benchmarks/bench.c generated/revolute/rpr3.c -lm -o bench
  *
  * Usage:
  *   bench PARAMS INPUTS N REPEATS [MODE]

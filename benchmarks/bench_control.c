@@ -4,7 +4,7 @@
  *
  * Build (from the repository root), as the harness does (the runtime's flags, minus -fPIC
  * -shared; and once more with -O2):
- *   cc -std=c99 -O3 -march=native -fno-tree-slp-vectorize -I generated/revolute \
+ *   cc -std=c99 -O3 -fno-math-errno -fno-trapping-math -march=native -mno-fma -I generated/revolute \
  *      benchmarks/bench_control.c generated/revolute/rpr3.c -lm -o bench_control
  *
  * Usage:

@@ -7,6 +7,7 @@ Run from anywhere with the project's interpreter (rpr3gen installed with the ``d
     python benchmarks/run.py --out FILE.md  # write the Markdown elsewhere
     python benchmarks/run.py --only control # one section (several: --only c --only python);
                                             # writes benchmarks/results-only-control.md
+    python benchmarks/run.py --readme       # full run, and README.md's performance tables
 
 It prints the report (Markdown) on stdout, progress on stderr, and writes the same Markdown to
 ``--out``. The measurements live in the package ``rpr3bench`` beside this file (``workers``:
@@ -54,9 +55,17 @@ def main(argv: Sequence[str] | None = None) -> int:
         help="run only this section (repeat for several): "
         + ", ".join(f"{key} ({title})" for key, title in sections.SECTIONS.items()),
     )
+    parser.add_argument(
+        "--readme",
+        action="store_true",
+        help="also write the run's targets and speed tables into README.md (between its "
+        "performance markers)",
+    )
     parser.add_argument("--worker", help=argparse.SUPPRESS)  # one measurement, in this process
     parser.add_argument("--args", default="{}", help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
+    if args.readme and args.only:
+        parser.error("--readme takes a run of every section (no --only)")
     if args.worker:
         print(json.dumps(workers.work(args.worker, json.loads(args.args))))
         return 0
@@ -77,6 +86,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(text)
     log(f"wrote {out}")
+    if args.readme:
+        readme = BENCH.parent / "README.md"
+        if not report.update_readme(readme, report.readme_block(command, info, results)):
+            log(f"{readme} has no performance markers: not written")
+            return 1
+        log(f"wrote the performance tables of {readme}")
     return 0
 
 

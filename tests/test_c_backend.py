@@ -1,4 +1,5 @@
-"""The generated C and the `c` backend: agreement, ABI behaviour, build cache, threads."""
+"""The generated C and the `c` backend: agreement, ABI behaviour, build cache, threads (the
+batch split across threads gives the same bits as one thread)."""
 
 from __future__ import annotations
 
@@ -218,3 +219,61 @@ def test_sample_evaluator_matches_batch() -> None:
         before = ev.out.copy()
         assert ev() == 2
         assert np.array_equal(ev.out, before)
+
+
+def _long_case(n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """n samples of random motion around the paper's home pose, with rows the batch handles
+    apart: a NaN input, a singular pose, and angles past the trig kernels' fast path (2^20)."""
+    rng = np.random.default_rng(15)  # poses about the paper's rotation, all valid
+    q = np.column_stack(
+        [rng.uniform(-0.01, 0.01, n), rng.uniform(-0.01, 0.01, n), rng.uniform(0.0, 1.0, n)]
+    )
+    qd, qdd = rng.normal(0.0, 0.1, (n, 3)), rng.normal(0.0, 1.0, (n, 3))
+    q[5, 1] = np.nan
+    q[7] = _singular_sample(_model(ne.paper_params(), "revolute"))
+    q[11:4000:97, 2] += 2.0 * np.pi * rng.integers(2**18, 2**40, len(q[11:4000:97]))
+    return q, qd, qdd
+
+
+@pytest.mark.parametrize("function", ["inverse_dynamics", "actuator_jacobian"])
+def test_every_thread_count_gives_the_same_bits(function: str) -> None:
+    model = rpr3gen.load_model()
+    q, qd, qdd = _long_case(3 * 4096 + 77)
+    inputs = (q, qd, qdd)[: len(manifest.load("revolute").function(function).inputs)]
+    one, codes = rpr3gen.evaluate(model, function, inputs, backend="c", threads=1)
+    assert np.flatnonzero(codes).tolist() == [5, 7]
+    for threads in (2, 3, None):
+        out, other = rpr3gen.evaluate(model, function, inputs, backend="c", threads=threads)
+        assert np.array_equal(codes, other)
+        assert all(a.tobytes() == b.tobytes() for a, b in zip(one, out, strict=True)), threads
+
+
+def test_batch_recomputes_huge_angles_like_the_single_call() -> None:
+    model = rpr3gen.load_model()
+    lib, names = _library("revolute")
+    params = np.ascontiguousarray(model.vector(names))
+    q, qd, qdd = (a[:40] for a in _long_case(40))
+    q[[0, 3, 4], 2] = (2.0**20, 3.0e9, -1.0e300)  # past the fast path, and far past it
+    rows, failed = _batch(params, q, qd, qdd, "revolute")
+    assert failed == 2  # the NaN input and the singular pose
+    out = np.empty(rows.shape[1])
+    for i in range(len(q)):
+        args = [np.ascontiguousarray(a[i]) for a in (q, qd, qdd)]
+        if lib.rpr3_inverse_dynamics(_ptr(params), *map(_ptr, args), _ptr(out)) == 0:
+            assert out.tobytes() == rows[i].tobytes(), i
+        else:
+            assert np.isnan(rows[i]).all()
+    assert np.isfinite(rows[[0, 3, 4]]).all()
+
+
+def test_threads_must_be_positive() -> None:
+    model = rpr3gen.load_model()
+    q = np.zeros((1, 3))
+    for bad in (0, -1, 1.5, True):
+        with pytest.raises(rpr3gen.InputError):
+            rpr3gen.inverse_dynamics(model, q, q, q, backend="c", threads=bad)
+    from rpr3gen.cli import main
+
+    with pytest.raises(SystemExit) as exit_info:
+        main(["simulate", "--backend", "c", "--threads", "0"])
+    assert exit_info.value.code == 2

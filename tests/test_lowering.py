@@ -100,3 +100,91 @@ def test_a_value_read_only_by_an_output_keeps_its_buffer() -> None:
     np.testing.assert_allclose(out[1], (x1 + values[a]) * 2.0, rtol=1e-15)
     np.testing.assert_allclose(out[2], values[a] - 2 * values[b], rtol=1e-15)
     np.testing.assert_allclose(out[3], values[b] ** 2 * values[a] / x1, rtol=1e-14)
+
+
+def test_copies_and_negations_fold_into_their_uses() -> None:
+    rng = np.random.default_rng(4)
+    n = 16
+    values = {a: rng.uniform(-1, 1, n), b: rng.uniform(-1, 1, n), k: 2.0, m: 3.0}
+    t4 = sp.Symbol("t4", real=True)
+    code = StraightLine(  # t2 = -t1, t3 = t2 (copy): -t3 - k is t1 - k, one subtraction
+        assignments=((t1, a * b), (t2, -t1), (t3, t2), (t4, -t3 - k)),
+        outputs=(("t4", t4), ("t3", t3)),
+        ops_before=0,
+        ops_after=0,
+    )
+    out = _run(code, values, n)
+    np.testing.assert_allclose(out[0], values[a] * values[b] - 2.0, rtol=1e-15)
+    np.testing.assert_allclose(out[1], -values[a] * values[b], rtol=1e-15)
+    lowered = lower_numpy(code, {a: "a", b: "b"}, {k, m}, {"t4": "out[0]", "t3": "out[1]"})
+    calls = [line.split("(")[0] for line in lowered.vector_lines]
+    assert calls == ["numpy.multiply", "numpy.add", "numpy.multiply"]  # t1 - k, then -t1
+
+
+def _generated_numpy():
+    from rpr3gen import manifest
+    from rpr3gen.evaluators import numpy_module
+
+    return numpy_module(manifest.load("revolute"))
+
+
+def test_sin_and_cos_of_one_argument_are_one_sincos_call() -> None:
+    rng = np.random.default_rng(5)
+    n = 64
+    values = {a: rng.uniform(-4, 4, n), b: rng.uniform(-1, 1, n), k: 2.0, m: 3.0}
+    code = StraightLine(
+        assignments=((t1, sp.cos(a)), (t2, sp.sin(a)), (t3, t1 * t2 + b * t1)),
+        outputs=(("y", t3), ("s", 2 * t2)),
+        ops_before=0,
+        ops_after=0,
+    )
+    rows = {"y": "out[0]", "s": "out[1]"}
+    lowered = lower_numpy(code, {a: "a", b: "b"}, {k, m}, rows)
+    assert lowered.sincos
+    assert sum("_sincos(" in line for line in lowered.vector_lines) == 1
+    assert not any("numpy.sin(" in line or "numpy.cos(" in line for line in lowered.vector_lines)
+    out = np.full((2, n), np.nan)
+    scope = {"numpy": np, "out": out, "a": values[a], "b": values[b], "k": 2.0, "m": 3.0,
+             "_sincos": _generated_numpy()._sincos}  # fmt: skip
+    for i in range(lowered.buffers):
+        scope[f"w{i}"] = np.empty(n)
+    exec("\n".join(lowered.scalar_lines + lowered.vector_lines), scope)
+    c, s = np.cos(values[a]), np.sin(values[a])
+    np.testing.assert_allclose(out[0], c * s + values[b] * c, rtol=1e-14, atol=1e-15)
+    np.testing.assert_allclose(out[1], 2 * s, rtol=1e-15)
+
+
+def test_generated_sincos_is_within_two_ulp() -> None:
+    sincos = _generated_numpy()._sincos
+    rng = np.random.default_rng(6)
+    turns = np.arange(1, 600_000, 7.0) * (np.pi / 2)
+    for x in (
+        np.linspace(-50.0, 50.0, 400_001),
+        rng.uniform(-(2.0**20), 2.0**20, 200_000),
+        np.concatenate([turns, np.nextafter(turns, 0.0), np.nextafter(turns, np.inf)]),
+        np.array([1e7, 3.0]),  # an argument past 2^20: the whole array goes to numpy
+    ):
+        s, c = np.empty_like(x), np.empty_like(x)
+        sincos(x, s, c, [np.empty_like(x) for _ in range(4)])
+        for got, want in ((s, np.sin(x)), (c, np.cos(x))):
+            assert np.max(np.abs(got - want) / np.spacing(np.abs(want))) <= 2.0
+    x = np.array([np.nan, 0.5])
+    s, c = np.empty(2), np.empty(2)
+    with np.errstate(invalid="ignore"):
+        sincos(x, s, c, [np.empty(2) for _ in range(4)])
+    assert np.isnan([s[0], c[0]]).all()
+    assert s[1] == np.sin(0.5)
+
+
+def test_scratch_rows_passed_in_give_the_same_bits() -> None:
+    import rpr3gen
+
+    module = _generated_numpy()
+    traj = rpr3gen.paper_trajectory("rotation", samples=50)
+    params = rpr3gen.load_model().vector(rpr3gen.PARAM_NAMES)
+    rows = module.WORK_ROWS["rpr3_inverse_dynamics"]
+    fresh, reused = np.empty((module.NUM_OUTPUTS, 50)), np.empty((module.NUM_OUTPUTS, 50))
+    module.rpr3_inverse_dynamics(params, traj.q, traj.qd, traj.qdd, fresh)
+    work = np.full((rows + 3, 80), np.nan)  # larger than needed, and dirty
+    module.rpr3_inverse_dynamics(params, traj.q, traj.qd, traj.qdd, reused, work=work)
+    assert fresh.tobytes() == reused.tobytes()

@@ -20,7 +20,16 @@ from typing import Any
 
 from rpr3bench.common import BENCH, CC, PY, REPO, log, shown, trajectory, variant
 
-C_FLAGS = ("-std=c99", "-O3", "-march=native")
+#: bench.c is built as the runtime builds the generated C (``cbackend.CFLAGS`` and the first
+#: ``EXTRA_FLAGS``, without ``-fPIC -shared``): -O3, no errno, no traps, no FMA, -march=native.
+C_FLAGS = (
+    "-std=c99",
+    "-O3",
+    "-fno-math-errno",
+    "-fno-trapping-math",
+    "-march=native",
+    "-mno-fma",
+)
 SOURCE = BENCH / "bench.c"
 
 
@@ -42,13 +51,10 @@ class CRun:
 
 
 def count_calls(source: str) -> dict[str, int]:
-    """How often each libm function is called in a C source."""
-    names = ("sin", "cos", "sqrt", "atan2", "pow", "exp", "log", "fabs", "isfinite")
-    return {
-        name: len(re.findall(rf"\b{name}\(", source))
-        for name in names
-        if re.search(rf"\b{name}\(", source)
-    }
+    """How often each libm function (or the generated kernel in its place) is called in the
+    kernels and batches of a C source (the math kernels' own definitions left out)."""
+    start = source.find("#define RPR3_BLOCK")
+    return count_in(source[start:] if start > 0 else source)
 
 
 def _command_output(command: Sequence[str]) -> str:
@@ -215,10 +221,7 @@ CONTROL_SOURCE = BENCH / "bench_control.c"
 MUJOCO_SOURCE = BENCH / "bench_mujoco.c"
 #: Builds of bench_control.c: the runtime's flags (``cbackend.CFLAGS`` and its first
 #: ``EXTRA_FLAGS``, without ``-fPIC -shared``), and plain -O2 as in examples/control_loop.
-CONTROL_BUILDS: dict[str, tuple[str, ...]] = {
-    "O3": ("-std=c99", "-O3", "-march=native", "-fno-tree-slp-vectorize"),
-    "O2": ("-std=c99", "-O2"),
-}
+CONTROL_BUILDS: dict[str, tuple[str, ...]] = {"O3": C_FLAGS, "O2": ("-std=c99", "-O2")}
 #: The paper's trajectories the control harness runs, one after the other, each sampled at 1 ms.
 CONTROL_TRAJECTORIES = ("rotation", "rectilinear")
 CONTROL_SAMPLES = 3001  # 3 s at 1 ms
@@ -228,9 +231,21 @@ CONTROL_SAMPLES = 3001  # 3 s at 1 ms
 LIBM = ("sin", "cos", "sqrt", "atan2", "atan", "pow", "exp", "log")
 
 
+def count_in(body: str, prefix: str = "rpr3") -> dict[str, int]:
+    """Calls of each :data:`LIBM` function in C text: libm's own (``sin(``) and the generated
+    C's kernels that stand for them (``rpr3_sin(``, ``rpr3_sin_fast(``)."""
+    found = {}
+    for f in LIBM:
+        count = len(re.findall(rf"(?:\b|\b{prefix}_){f}(?:_fast)?\(", body))
+        if count:
+            found[f] = count
+    return found
+
+
 def kernel_calls(actuation: str) -> dict[str, dict[str, int]]:
-    """libm calls (:data:`LIBM`) in the body of each ``rpr3_NAME_kernel`` of a variant's
-    generated C, by NAME."""
+    """libm calls (:data:`LIBM`, or the generated kernels in their place) in the body of each
+    ``rpr3_NAME_kernel`` of a variant's generated C, by NAME: after CSE, what one sample of
+    that function must evaluate."""
     from rpr3gen import manifest
 
     source = manifest.load(actuation).path("c_source").read_text()
@@ -238,10 +253,7 @@ def kernel_calls(actuation: str) -> dict[str, dict[str, int]]:
     calls = {}
     for match in kernels:
         end = source.find("\nint rpr3_", match.start())
-        body = source[match.start() : end if end > 0 else None]
-        calls[match.group(1)] = {
-            f: len(re.findall(rf"\b{f}\(", body)) for f in LIBM if re.search(rf"\b{f}\(", body)
-        }
+        calls[match.group(1)] = count_in(source[match.start() : end if end > 0 else None])
     return calls
 
 

@@ -2,8 +2,9 @@
 
 The samples are the paper's platform rotation, eq. (3); the robot is the paper's
 (``load_model()``, the ``revolute`` variant). A function of the manifest is measured when the
-benchmarks can give it samples: today every input named ``q``, ``qd`` or ``qdd`` (the pose and
-its derivatives along the trajectory).
+benchmarks can give it samples: every input named ``q``, ``qd`` or ``qdd`` (the pose and its
+derivatives along the trajectory); the per-function section also takes an input that another
+such function gives as an output of that name (``tau``, ``qa``).
 """
 
 from __future__ import annotations
@@ -83,16 +84,65 @@ def measurable(function: FunctionInfo) -> bool:
     return all(a.name in SAMPLE_INPUTS and a.size == 3 for a in function.inputs)
 
 
+def producer(name: str, size: int) -> FunctionInfo | None:
+    """The first function of the measured variant that takes trajectory samples only and has a
+    public output ``name`` of ``size`` components (``tau`` of ``actuator_efforts``)."""
+    for function in variant().functions.values():
+        if measurable(function) and any(
+            o.name == name and o.size == size for o in function.public_outputs
+        ):
+            return function
+    return None
+
+
+def derivable(function: FunctionInfo) -> bool:
+    """Whether every input is a trajectory sample or another function's output
+    (:func:`producer`)."""
+    return all(
+        (a.name in SAMPLE_INPUTS and a.size == 3) or producer(a.name, a.size) is not None
+        for a in function.inputs
+    )
+
+
 def sample_inputs(function: FunctionInfo, n: int) -> list[Any]:
-    """The inputs of ``function`` for n samples of the trajectory, in its order."""
+    """The inputs of ``function`` for n samples of the trajectory, in its order: the trajectory's
+    own, or the output of the function that gives that name (its NumPy version, on the same
+    samples)."""
+    import rpr3gen
+
     arrays = trajectory(n)
-    return [arrays[a.name] for a in function.inputs]
+    inputs = []
+    for a in function.inputs:
+        if a.name in SAMPLE_INPUTS and a.size == 3:
+            inputs.append(arrays[a.name])
+            continue
+        source = producer(a.name, a.size)
+        assert source is not None, f"no samples for {function.name}'s input {a.name}"
+        outputs, _ = rpr3gen.evaluate(
+            rpr3gen.load_model(), source.name, [arrays[i.name] for i in source.inputs]
+        )
+        index = [o.name for o in source.public_outputs].index(a.name)
+        inputs.append(outputs[index])
+    return [np_contiguous(x) for x in inputs]
+
+
+def np_contiguous(array: Any) -> Any:
+    import numpy as np
+
+    return np.ascontiguousarray(array, dtype=np.float64)
 
 
 def functions() -> tuple[list[str], list[str]]:
     """Names of the measured variant's functions: (measured, skipped for want of samples)."""
     found = variant().functions
     measured = [name for name, f in found.items() if measurable(f)]
+    return measured, [name for name in found if name not in measured]
+
+
+def derived_functions() -> tuple[list[str], list[str]]:
+    """As :func:`functions`, counting inputs that other functions give (:func:`derivable`)."""
+    found = variant().functions
+    measured = [name for name, f in found.items() if derivable(f)]
     return measured, [name for name in found if name not in measured]
 
 

@@ -283,6 +283,99 @@ def targets(results: dict[str, Any]) -> str:
     return table(["target", "measured", "goal", "result", "margin"], rows) + "\n"
 
 
+def speed_summary(results: dict[str, Any]) -> str:
+    """Issue 15's figures in one table: C single and batch against the floor, the threaded
+    batch, NumPy against Newton-Euler, and every generated function against its own floor."""
+    c = results.get("c", {})
+    rows = []
+    floor = c.get("floor_ns")
+    if floor:
+        rows.append(
+            [
+                f"`{SCORED}`: C single call, C batch 10^6 (streamed) / of 1,000 (in cache)",
+                f"{ns(floor)} ns",
+                f"{ns(c['single_ns'])} ns = {ratio(c['single_ns'] / floor)}",
+                f"{ns(c['batch_ns'])} ns = {ratio(c['batch_ns'] / floor)} / "
+                f"{ns(c['batch_small_ns'])} ns = {ratio(c['batch_small_ns'] / floor)}",
+                "",
+            ]
+        )
+    threads = c.get("threads") or {}
+    if threads.get("threads"):
+        k = threads["threads"][-1]
+        cached = threads["cached"]
+        streamed = threads["streamed"].get(str(10**6))
+        rows.append(
+            [
+                f"C batch on {k} threads: speed-up over one",
+                "",
+                "",
+                f"in cache {ratio(cached['1'] / cached[str(k)])}"
+                + (f"; 10^6 streamed {ratio(streamed[0] / streamed[-1])}" if streamed else ""),
+                "",
+            ]
+        )
+    for n, value in sorted(results.get("peers", {}).get("ne_ratio", {}).items()):
+        rows.append(
+            [f"NumPy vs Newton–Euler, {size_label(n)}", "", "", "", f"{ratio(value)} faster"]
+        )
+    for name, f in results.get("functions", {}).items():
+        base = f["floor_ns"]
+        rows.append(
+            [
+                f"`{name}`",
+                f"{ns(base)} ns",
+                f"{ns(f['single_ns'])} ns = {ratio(f['single_ns'] / base)}",
+                f"{ns(f['batch_ns'])} ns = {ratio(f['batch_ns'] / base)}",
+                f"{ns(f['numpy_ns'])} ns = {ratio(f['numpy_ns'] / base)}" if f.get("numpy_ns")
+                else "n/a",
+            ]
+        )  # fmt: skip
+    if not rows:
+        return ""
+    return (
+        table(["issue 15", "floor", "C single", "C batch", "NumPy"], rows)
+        + "\n\nFloors: the libm calls a sample must make (section 3 for the headline: one "
+        "sin/cos, 3 sqrt, 3 atan2; section 7 per function: the calls of its kernel after CSE). "
+        "Per function, the C batch runs over chunks of 1,000 samples (outputs in cache) and "
+        "NumPy is `evaluate` at 10^5 samples. Goals: C single ≤ 2x, C batch ≤ 1.2x the floor, "
+        "NumPy ≥ 20x Newton–Euler.\n"
+    )
+
+
+README_BEGIN = "<!-- performance: written by `python benchmarks/run.py --readme`; do not edit -->"
+README_END = "<!-- end of performance -->"
+
+
+def readme_block(command: str, info: dict[str, str], results: dict[str, Any]) -> str:
+    """The README's performance tables: where and when they were measured, the targets table,
+    and issue 15's summary."""
+    where = (
+        f"`{command}`, {info.get('date', 'n/a')} ({info.get('cpu', 'n/a')}, "
+        f"{info.get('cores', 'n/a')}, {info.get('compiler', 'n/a')}, git "
+        f"{info.get('git', 'n/a').split(' ')[0]}; {info.get('run', 'n/a')}; load average "
+        f"{info.get('load average (start)', 'n/a').split(' (')[0]} at the start, "
+        f"{info.get('load average (end)', 'n/a').split(' (')[0]} at the end):"
+    )
+    parts = [README_BEGIN, where, "", targets(results), speed_summary(results).rstrip()]
+    if "control" in results:
+        from rpr3bench.control import _summary
+
+        parts += ["", "The control model in that run:", "", _summary(results["control"]).rstrip()]
+    return "\n".join([*parts, README_END])
+
+
+def update_readme(path: Any, block: str) -> bool:
+    """Replace the text between the README's performance markers by ``block``; False when the
+    README has no such markers."""
+    text = path.read_text(encoding="utf-8")
+    start, end = text.find(README_BEGIN), text.find(README_END)
+    if start < 0 or end < start:
+        return False
+    path.write_text(text[:start] + block + text[end + len(README_END) :], encoding="utf-8")
+    return True
+
+
 # ---------------------------------------------------------------------------------------------
 # The document
 # ---------------------------------------------------------------------------------------------
@@ -312,6 +405,9 @@ def document(
         lines.append("")
     lines.append(table(["machine", ""], [[k, v] for k, v in info.items()]))
     lines += ["", "## Targets", "", targets(results)]
+    summary = speed_summary(results)
+    if summary:
+        lines += ["### Speed (issue 15)", "", summary]
     for title, body in sections:
         lines += [f"## {title}", "", body]
     return "\n".join(lines).rstrip() + "\n"

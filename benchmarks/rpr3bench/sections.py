@@ -13,7 +13,7 @@ import time
 from collections import defaultdict
 from typing import Any
 
-from rpr3bench import charness
+from rpr3bench import charness, speed
 from rpr3bench.common import (
     CODE_IDS,
     PY,
@@ -27,6 +27,7 @@ from rpr3bench.common import (
 )
 from rpr3bench.report import SCORED, mb, median, ns, ratio, secs, size_label, table
 from rpr3bench.workers import SHARED, NumpyCalls, run_worker
+from rpr3gen.evaluators import all_cores
 
 STAGES = ("derive", "cse", "print", "render")
 
@@ -314,7 +315,8 @@ def section_numpy(quick: bool, ops: dict[str, Any]) -> tuple[str, dict[str, Any]
             )
     if notes:
         text += "\n" + "\n".join(notes) + "\n"
-    return text + _skipped_note(skipped), results
+    profile_text, results["profile"] = speed.numpy_profile(quick)
+    return text + _skipped_note(skipped) + profile_text, results
 
 
 # ---------------------------------------------------------------------------------------------
@@ -388,15 +390,19 @@ def section_c(quick: bool) -> tuple[str, dict[str, Any]]:
             ]
         )
     agree = values.get("single_checksum") == values.get("batch_checksum")
-    calls_text = ", ".join(f"{count} {name}" for name, count in calls.items())
+    kernel = charness.kernel_calls(VARIANT).get(SCORED, {})
+    calls_text = ", ".join(f"{count} {name}" for name, count in kernel.items())
     text = table(["loop", "ns/sample", "vs scalar floor", "note"], rows)
     text += (
         f"\n\n`{' '.join(run.command)}` (bench.c, best of {repeats}, {size_label(n)} samples of "
-        f"the paper's {TRAJECTORY} trajectory, loops interleaved). Failed samples: single "
-        f"{values.get('single_failed', 0):.0f}, batch {values.get('batch_failed', 0):.0f}; single "
-        f"and batch checksums {'agree bit for bit' if agree else '**differ**'}; the probe sample "
-        f"agrees with the generated NumPy to {worst:.1e} (relative). The generated C calls, per "
-        f"sample: {calls_text}. gcc merges each sin/cos pair into one `sincos` call"
+        f"the paper's {TRAJECTORY} trajectory, loops interleaved; the runtime's flags). Failed "
+        f"samples: single {values.get('single_failed', 0):.0f}, batch "
+        f"{values.get('batch_failed', 0):.0f}; single and batch checksums "
+        f"{'agree bit for bit' if agree else '**differ**'}; the probe sample agrees with the "
+        f"generated NumPy to {worst:.1e} (relative). One sample of `{SCORED}` evaluates "
+        f"{calls_text} (after CSE), with the generated C's own kernels (no libm: "
+        "`derive/codegen/mathkernels.py`); the floors call libm's, and gcc merges each sin/cos "
+        "pair of them into one `sincos` call"
         + (" (it does here)" if "sincos" in run.symbols else "")
         + ".\n"
     )
@@ -417,8 +423,11 @@ def section_c(quick: bool) -> tuple[str, dict[str, Any]]:
         )
     else:
         text += "\n(`perf` not available: no breakdown of the C time by function.)\n"
+    asm_text, asm = speed.c_assembly()
+    threads_text, threads = speed.c_threads(quick, all_cores())
     CODE_IDS.append(("c harness end", code_id()))
-    return text, dict(values, fast_floor_ns=run.fast_values.get("floor_ns"))
+    result = dict(values, fast_floor_ns=run.fast_values.get("floor_ns"), asm=asm, threads=threads)
+    return text + asm_text + threads_text, result
 
 
 # ---------------------------------------------------------------------------------------------
@@ -584,7 +593,9 @@ def _newton_euler(quick: bool, numpy_results: dict[str, Any]) -> tuple[str, dict
         "(kinematics, an (n, 21, 21) system, one batched `numpy.linalg.solve`) interleaved "
         'with the NumPy backend `evaluate(model, "inverse_dynamics", (q, qd, qdd), '
         'backend="numpy")` and the generated function in one call, on the same samples in one '
-        f"process (best of {len(ne['sizes'][0]['ne'])}); the difference column compares the "
+        f"process (best of {len(ne['sizes'][0]['ne'])}; each timed right after an untimed run "
+        "of itself, so that each is measured warm and none just after the other's cache "
+        "footprint); the difference column compares the "
         f"{ne['sizes'][0]['compared']} outputs both give (backend against Newton–Euler, "
         "relative to max(1, |value|)). The parameters of `newton_euler.paper_params()` and of "
         f"`load_model()` differ by at most {ne['param_diff']:.1e}.\n"
@@ -612,6 +623,7 @@ SECTIONS: dict[str, str] = {
     "python": "4. Python single-sample call into C",
     "peers": "5. Peers",
     "control": "6. Control model",
+    "functions": "7. Every generated function against its floor",
 }
 
 
@@ -621,6 +633,7 @@ def run_all(
     """Every section in order (or those of ``only``): ``[(title, Markdown)]`` and the results
     by section. A section whose input section did not run gets none (its figures say n/a)."""
     from rpr3bench.control import section_control
+    from rpr3bench.functions import section_functions
 
     runs = {
         "regen": lambda r: section_regen(quick),
@@ -629,6 +642,7 @@ def run_all(
         "python": lambda r: section_python(quick, r.get("c", {}).get("single_ns")),
         "peers": lambda r: section_peers(quick, r.get("numpy", {})),
         "control": lambda r: section_control(quick),
+        "functions": lambda r: section_functions(quick),
     }
     results: dict[str, Any] = {}
     sections = []

@@ -9,6 +9,7 @@ out of another's (each NumPy size).
 from __future__ import annotations
 
 import contextlib
+import functools
 import json
 import os
 import resource
@@ -29,6 +30,7 @@ from rpr3bench.common import (
     sample_inputs,
     variant,
 )
+from rpr3bench.speedworkers import WORKERS as SPEED_WORKERS
 
 SHARED = "shared"  # the stages of regeneration outside any variant
 
@@ -283,13 +285,18 @@ def worker_newton_euler(args: dict[str, Any]) -> dict[str, Any]:
         outputs = calls.allocate(n)
         t_ne, t_np, t_direct = [], [], []
         ref, got = {}, {}
+        # Interleaved, each timed right after an untimed run of itself: every candidate is
+        # measured warm, none just after another one's cache footprint (NE's is ~35 MB at 10^4).
         for _ in range(int(args["repeats"])):
+            ne.solve(ne_params, VARIANT, q, qd, qdd)
             start = time.perf_counter()
             ref = ne.solve(ne_params, VARIANT, q, qd, qdd)
             t_ne.append(time.perf_counter() - start)
+            calls.backend(q, qd, qdd)
             start = time.perf_counter()
             got = calls.named(calls.backend(q, qd, qdd))
             t_np.append(time.perf_counter() - start)
+            calls.direct([q, qd, qdd], outputs)
             start = time.perf_counter()
             calls.direct([q, qd, qdd], outputs)
             t_direct.append(time.perf_counter() - start)
@@ -327,7 +334,11 @@ def worker_lambdify(args: dict[str, Any]) -> dict[str, Any]:
     # (SymPy's, plus those) prints them. Everything else is plain lambdify.
     printer = NumpyPrinter()
     start = time.perf_counter()
-    func = sp.lambdify(arguments, expanded, modules="numpy", cse=False, printer=printer)
+    # SymPy's NumPy printer folds Min/Max with functools.reduce: the namespace needs functools.
+    func = sp.lambdify(
+        arguments, expanded, modules=[{"functools": functools}, "numpy"], cse=False,
+        printer=printer,
+    )  # fmt: skip
     t_lambdify = time.perf_counter() - start
     expanded_ops = sum(int(sp.count_ops(e)) for e in expanded)
 
@@ -349,12 +360,12 @@ def worker_lambdify(args: dict[str, Any]) -> dict[str, Any]:
         start = time.perf_counter()
         got = calls.backend(*inputs)
         t_gen.append(time.perf_counter() - start)
-    index = {o.name: k for k, o in enumerate(spec.outputs)}
+    index = {o.name: k for k, o in enumerate(spec.public_outputs)}  # evaluate() returns these
     lam = {
         f"{o}[{k}]": np.broadcast_to(np.asarray(value, dtype=float), (n,))
         for (o, k, _), value in zip(flat, result, strict=True)
     }
-    gen = {f"{o}[{k}]": got[index[o]][:, k] for o, k, _ in flat}
+    gen = {f"{o}[{k}]": got[index[o]][:, k] for o, k, _ in flat if o in index}
     worst, compared = _relative_difference(lam, gen)
     return {
         "function": name,
@@ -824,6 +835,7 @@ WORKERS: dict[str, Callable[[dict[str, Any]], dict[str, Any]]] = {
     "control_python": worker_control_python,
     "fk_iterations": worker_fk_iterations,
     "mujoco": worker_mujoco,
+    **SPEED_WORKERS,
 }
 
 

@@ -8,6 +8,7 @@ it in blocks through an evaluator (:mod:`rpr3gen.evaluators`) and applies the fa
 
 from __future__ import annotations
 
+import itertools
 import os
 import sys
 from collections.abc import Iterator, Sequence
@@ -17,7 +18,7 @@ from numpy.typing import ArrayLike
 
 from rpr3gen import manifest, policy
 from rpr3gen.errors import InputError
-from rpr3gen.evaluators import BACKENDS, evaluator
+from rpr3gen.evaluators import BACKENDS, NumpyEvaluator, evaluator, thread_count
 from rpr3gen.model import Model
 
 __all__ = ["BACKENDS", "OUTPUT_NAMES", "evaluate", "inverse_dynamics"]
@@ -28,9 +29,10 @@ __all__ = ["BACKENDS", "OUTPUT_NAMES", "evaluate", "inverse_dynamics"]
 OUTPUT_NAMES: tuple[str, ...] = (
     manifest.load(manifest.available()[0]).function("inverse_dynamics").outputs[0].names
 )
-#: Samples evaluated per call of the generated code: the NumPy temporaries of one block stay
-#: in cache and memory stays bounded however long the trajectory (benchmarks/ measures this).
-BLOCK = 8192
+#: Samples per call of the generated NumPy code: the temporaries of one block stay in cache
+#: and memory stays bounded however long the trajectory (benchmarks/ measures this). The C
+#: backend takes larger blocks (``CEvaluator.block``), split across threads.
+BLOCK = NumpyEvaluator.block
 #: Seconds before the progress bar shows (tqdm's ``delay``).
 PROGRESS_DELAY = 0.5
 
@@ -48,14 +50,18 @@ def samples(name: str, value: ArrayLike, size: int) -> np.ndarray:
     return np.ascontiguousarray(array)
 
 
-def _blocks(n: int, progress: bool) -> Iterator[slice]:
-    """Consecutive blocks of at most :data:`BLOCK` samples, with a progress bar on request.
+def _blocks(n: int, progress: bool, block: int = BLOCK) -> Iterator[slice]:
+    """Consecutive blocks of at most ``block`` samples, as equal as can be (10^4 samples are one
+    block of 10^4, not 8,192 and 1,808: every block costs the same fixed dispatch), with a
+    progress bar on request.
 
     The bar goes to stderr, only when it is a terminal and the run lasts over
     :data:`PROGRESS_DELAY` seconds.
     """
-    starts = range(0, n, BLOCK)
-    if progress and sys.stderr.isatty() and n > BLOCK:
+    count = max(1, -(-n // block))
+    bounds = [n * k // count for k in range(count + 1)]
+    blocks = [slice(lo, hi) for lo, hi in itertools.pairwise(bounds)]
+    if progress and sys.stderr.isatty() and count > 1:
         from tqdm import tqdm
 
         try:  # a terminal that reports no size (serial consoles, some CI) gets 80 x 24
@@ -71,13 +77,12 @@ def _blocks(n: int, progress: bool) -> Iterator[slice]:
             ncols=size.columns or 80,
             nrows=size.lines or 24,
         )
-        for lo in starts:
-            yield slice(lo, min(lo + BLOCK, n))
-            bar.update(min(BLOCK, n - lo))
+        for part in blocks:
+            yield part
+            bar.update(part.stop - part.start)
         bar.close()
     else:
-        for lo in starts:
-            yield slice(lo, min(lo + BLOCK, n))
+        yield from blocks
 
 
 def evaluate(
@@ -86,6 +91,7 @@ def evaluate(
     inputs: Sequence[ArrayLike],
     backend: str = "numpy",
     progress: bool = False,
+    threads: int | None = None,
 ) -> tuple[list[np.ndarray], np.ndarray]:
     """Evaluate the generated function ``function`` of the model's variant over n samples.
 
@@ -95,6 +101,8 @@ def evaluate(
         inputs: one array per input of the function, each (n, size) (or (size,) for one sample).
         backend: ``"numpy"`` or ``"c"``.
         progress: show a progress bar on stderr when it is a terminal (long runs).
+        threads: threads of the ``"c"`` backend (default: every core this process may use);
+            the results do not depend on it, bit for bit. The NumPy backend uses one.
 
     Returns:
         The outputs of the function's interface, each seen as (n, size), and the (n,) return
@@ -109,13 +117,17 @@ def evaluate(
         shapes = ", ".join(str(a.shape) for a in arrays)
         names = ", ".join(arg.name for arg in info.inputs)
         raise InputError(f"{names} differ in shape: {shapes}")
+    count = thread_count(threads)
     ev = evaluator(variant, backend)
     params = model.vector(variant.param_names)
     n = arrays[0].shape[0]
     outputs = ev.allocate(info, n)
-    for block in _blocks(n, progress):
-        ev.run(info, params, [a[block] for a in arrays], [o[block] for o in outputs])
-    codes = policy.apply(info, arrays, outputs, applied=ev.applies_checks)
+    codes = np.zeros(n, dtype=np.intc)
+    for block in _blocks(n, progress, ev.block):
+        ins, outs = [a[block] for a in arrays], [o[block] for o in outputs]
+        failed = ev.run(info, params, ins, outs, count)
+        if failed != 0:  # unknown (NumPy), or the C counted some: find them while in cache
+            codes[block] = policy.apply(info, ins, outs, applied=ev.applies_checks)
     public = [o for o, arg in zip(outputs, info.outputs, strict=True) if not arg.hidden]
     return public, codes
 
@@ -127,6 +139,7 @@ def inverse_dynamics(
     qdd: ArrayLike,
     backend: str = "numpy",
     progress: bool = False,
+    threads: int | None = None,
 ) -> dict[str, np.ndarray]:
     """Leg kinematics, actuator loads and every joint load for n platform samples.
 
@@ -138,6 +151,7 @@ def inverse_dynamics(
         backend: ``"numpy"`` (generated NumPy) or ``"c"`` (generated C, compiled on first use
             and cached; see :mod:`rpr3gen.cbackend`).
         progress: show a progress bar on stderr when it is a terminal (long trajectories).
+        threads: threads of the ``"c"`` backend (default: every core); same results whatever.
 
     Returns:
         ``{name: (n,) array}`` for every name of :data:`OUTPUT_NAMES` (docs/conventions.md:
@@ -147,6 +161,6 @@ def inverse_dynamics(
         is raised, so callers decide (``rpr3gen simulate`` refuses such a trajectory). The
         arrays are views of one block (strided with ``"c"``).
     """
-    (out,), _ = evaluate(model, "inverse_dynamics", (q, qd, qdd), backend, progress)
+    (out,), _ = evaluate(model, "inverse_dynamics", (q, qd, qdd), backend, progress, threads)
     names = manifest.load(model.actuation, model.generated).function("inverse_dynamics")
     return dict(zip(names.outputs[0].names, out.T, strict=True))

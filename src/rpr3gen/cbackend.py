@@ -29,14 +29,26 @@ from typing import Any
 from rpr3gen.errors import Rpr3genError
 from rpr3gen.manifest import Variant
 
-CFLAGS: tuple[str, ...] = ("-std=c99", "-O3", "-fPIC", "-shared")
+#: ISO C99 (no FMA contraction), -O3; no errno from sqrt and no floating-point traps, so that
+#: the batch loops vectorise (the generated C's math kernels are branch-free; these two flags
+#: change no value, unlike -ffast-math).
+CFLAGS: tuple[str, ...] = (
+    "-std=c99",
+    "-O3",
+    "-fno-math-errno",
+    "-fno-trapping-math",
+    "-fPIC",
+    "-shared",
+)
 #: Extra flags, tried in order until the compiler accepts them: tuned for the machine that
-#: builds and uses the library; gcc's basic-block (SLP) vectoriser off, because with FMA it
-#: fuses multiply-adds differently in the single and the batch function (the batch's loop
-#: vectorisation is unaffected), and the two must agree bit for bit.
+#: builds and uses the library, without FMA instructions. ISO C forbids contracting a * b + c
+#: into an FMA, but gcc's basic-block (SLP) vectoriser fuses multiply-adds (``.VEC_FMSUBADD``)
+#: all the same; with no FMA instruction it cannot, and it may vectorise the single-sample
+#: function, which must agree bit for bit with the batch. Where -mno-fma is unknown, the SLP
+#: vectoriser is turned off instead.
 EXTRA_FLAGS: tuple[tuple[str, ...], ...] = (
+    ("-march=native", "-mno-fma"),
     ("-march=native", "-fno-tree-slp-vectorize"),
-    ("-march=native",),
     (),
 )
 LIBS: tuple[str, ...] = ("-lm",)

@@ -72,6 +72,27 @@ def _conditioning_threshold(text: str) -> float:
     return value
 
 
+def _threads(text: str) -> int:
+    """Type of ``--threads``: a positive integer."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not an integer: {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be at least 1, got {text}")
+    return value
+
+
+def _add_threads(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--threads",
+        type=_threads,
+        metavar="N",
+        help="threads of the c backend (default: every core this process may use); the "
+        "results do not depend on it",
+    )
+
+
 def _parser() -> argparse.ArgumentParser:
     parser = _Parser(
         prog="rpr3gen",
@@ -121,6 +142,7 @@ def _parser() -> argparse.ArgumentParser:
         default="numpy",
         help="evaluate the generated NumPy or C code (default: numpy)",
     )
+    _add_threads(sim)
     sim.add_argument(
         "--out",
         metavar="FILE.csv",
@@ -162,6 +184,7 @@ def _parser() -> argparse.ArgumentParser:
         default="numpy",
         help="evaluate the generated NumPy or C code (default: numpy)",
     )
+    _add_threads(paper)
 
     par = sub.add_parser(
         "params", help="print a model's parameter vector as 'name value' lines (for C users)"
@@ -435,6 +458,7 @@ def simulate(
     plots_dir: str | None,
     min_conditioning: float = DEFAULT_MIN_CONDITIONING,
     allow_invalid: bool = False,
+    threads: int | None = None,
 ) -> tuple[dict[str, np.ndarray], Invalid | None]:
     """Evaluate, screen, and write the CSV and figures of one trajectory.
 
@@ -452,7 +476,9 @@ def simulate(
         _check_destination(Path(out_csv), "the CSV", folder=False)
     if plots_dir:
         _check_destination(Path(plots_dir), "the figures", folder=True)
-    out = inverse_dynamics(model, traj.q, traj.qd, traj.qdd, backend=backend, progress=True)
+    out = inverse_dynamics(
+        model, traj.q, traj.qd, traj.qdd, backend=backend, progress=True, threads=threads
+    )
     invalid = _screen(model, traj, out, min_conditioning, allow_invalid)
     if out_csv:
         Path(out_csv).parent.mkdir(parents=True, exist_ok=True)
@@ -502,6 +528,7 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
         args.plots,
         min_conditioning=args.min_conditioning,
         allow_invalid=args.allow_invalid,
+        threads=args.threads,
     )
     if invalid is not None:
         _warn(f"{name}: {_refused(traj, invalid)}")
@@ -516,7 +543,13 @@ def _cmd_paper(args: argparse.Namespace) -> int:
     for name in PAPER_TRAJECTORIES:
         traj = paper_trajectory(name)
         out, _ = simulate(
-            model, name, traj, args.backend, str(root / f"{name}.csv"), str(root / "figures")
+            model,
+            name,
+            traj,
+            args.backend,
+            str(root / f"{name}.csv"),
+            str(root / "figures"),
+            threads=args.threads,
         )
         summaries.append(_summary(name, model, traj, out))
     print("\n".join(summaries))

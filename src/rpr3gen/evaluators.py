@@ -3,15 +3,21 @@
 An :class:`Evaluator` evaluates any function of a generated variant's manifest over a block of
 samples (:meth:`~Evaluator.run`) into output arrays it allocates in its own layout
 (:meth:`~Evaluator.allocate`; always seen as (n, size)). ``numpy`` runs the generated NumPy
-module; ``c`` the generated C, compiled and bound by :mod:`rpr3gen.cbackend`. Neither knows any
-function in particular: both read the manifest.
+module; ``c`` the generated C, compiled and bound by :mod:`rpr3gen.cbackend`, on every core:
+its batch functions are re-entrant and ctypes releases the GIL while they run, so contiguous
+chunks of a block run on a pool of threads (:data:`threads`). Neither knows any function in
+particular: both read the manifest.
 """
 
 from __future__ import annotations
 
 import importlib.util
+import itertools
+import os
 import sys
+import threading
 from collections.abc import Sequence
+from concurrent.futures import ThreadPoolExecutor
 from types import ModuleType
 from typing import Protocol
 
@@ -23,6 +29,36 @@ from rpr3gen.manifest import FunctionInfo, Variant
 BACKENDS: tuple[str, ...] = ("numpy", "c")
 
 
+def all_cores() -> int:
+    """The cores this process may run on (its CPU affinity), at least 1."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:  # not on Linux
+        return os.cpu_count() or 1
+
+
+def thread_count(threads: int | None) -> int:
+    """``threads``, checked, or every core for None."""
+    if threads is None:
+        return all_cores()
+    if isinstance(threads, bool) or not isinstance(threads, int) or threads < 1:
+        raise InputError(f"threads must be a positive integer, got {threads!r}")
+    return threads
+
+
+_POOL: tuple[ThreadPoolExecutor, int] | None = None  # the pool and its size
+_POOL_LOCK = threading.Lock()
+
+
+def _pool(workers: int) -> ThreadPoolExecutor:
+    """A shared pool of at least ``workers`` threads (made once, grown on demand)."""
+    global _POOL
+    with _POOL_LOCK:
+        if _POOL is None or _POOL[1] < workers:
+            _POOL = (ThreadPoolExecutor(max_workers=workers, thread_name_prefix="rpr3gen"), workers)
+        return _POOL[0]
+
+
 class Evaluator(Protocol):
     """Evaluates the functions of one generated variant.
 
@@ -32,6 +68,7 @@ class Evaluator(Protocol):
 
     variant: Variant
     applies_checks: bool
+    block: int  # samples per call of run() from rpr3gen.evaluate (bounds temporaries, progress)
 
     def allocate(self, function: FunctionInfo, n: int) -> list[np.ndarray]:
         """Uninitialised outputs for n samples, each seen as (n, size)."""
@@ -43,9 +80,11 @@ class Evaluator(Protocol):
         params: np.ndarray,
         inputs: Sequence[np.ndarray],
         outputs: Sequence[np.ndarray],
-    ) -> None:
+        threads: int = 1,
+    ) -> int | None:
         """Evaluate n samples: ``inputs`` (n, size) C-contiguous float64, ``outputs`` rows of
-        arrays from :meth:`allocate`. Failed samples hold inf or NaN (see :mod:`rpr3gen.policy`)."""
+        arrays from :meth:`allocate`, on up to ``threads`` threads. Failed samples hold inf or
+        NaN (see :mod:`rpr3gen.policy`). Returns how many failed, when the backend knows."""
         ...
 
 
@@ -65,13 +104,32 @@ def numpy_module(variant: Variant) -> ModuleType:
 
 
 class NumpyEvaluator:
-    """The generated NumPy code; outputs are stored (size, n), so each output row is contiguous."""
+    """The generated NumPy code; outputs are stored (size, n), so each output row is contiguous.
+
+    One thread: ``threads`` is accepted and ignored. The generated functions' scratch rows
+    (``work``) are one array per thread, kept between calls: fresh ones would cost mapping and
+    zeroing new pages at every block.
+    """
 
     applies_checks = False
+    #: The generated code's temporaries of one block stay in cache, and its ~650 ufunc calls'
+    #: fixed cost is spread over enough samples (benchmarks/ measures it).
+    block = 12288
 
     def __init__(self, variant: Variant) -> None:
         self.variant = variant
         self.module = numpy_module(variant)
+        self._scratch = threading.local()
+
+    def _work(self, rows: int, n: int) -> np.ndarray | None:
+        """This thread's scratch array, at least ``rows`` x ``n`` (grown on demand)."""
+        if not rows:
+            return None
+        work = getattr(self._scratch, "work", None)
+        if work is None or work.shape[0] < rows or work.shape[1] < n:
+            shape = (rows, n) if work is None else (max(rows, work.shape[0]), max(n, work.shape[1]))
+            work = self._scratch.work = np.empty(shape)
+        return work
 
     def allocate(self, function: FunctionInfo, n: int) -> list[np.ndarray]:
         return [np.empty((o.size, n)).T for o in function.outputs]
@@ -82,23 +140,37 @@ class NumpyEvaluator:
         params: np.ndarray,
         inputs: Sequence[np.ndarray],
         outputs: Sequence[np.ndarray],
-    ) -> None:
+        threads: int = 1,
+    ) -> int | None:
         if function.numpy_function is None:
             raise InputError(
                 f"{function.name} has no NumPy version (its generated code is C only); "
                 "use backend='c'"
             )
         call = getattr(self.module, function.numpy_function)
-        call(params, *inputs, *(o.T for o in outputs))
+        rows = getattr(self.module, "WORK_ROWS", {}).get(function.numpy_function)
+        if rows is None:  # generated before the work argument
+            call(params, *inputs, *(o.T for o in outputs))
+        else:
+            work = self._work(rows, inputs[0].shape[0])
+            call(params, *inputs, *(o.T for o in outputs), work=work)
+        return None
 
 
 class CEvaluator:
     """The generated C, through its batch functions; outputs are row-major (n, size).
 
-    Hidden outputs (the values the checks test) stay inside the C: they are allocated, NaN.
+    A block of at least 2 :data:`MIN_CHUNK` samples is split into contiguous chunks, one per
+    thread; each sample's result does not depend on the split (the generated batch evaluates
+    every sample alone), so every thread count gives the same bits. Hidden outputs (the values
+    the checks test) stay inside the C: they are allocated, NaN.
     """
 
     applies_checks = True
+    #: The batch keeps no temporaries between samples: blocks only pace the progress bar.
+    block = 1 << 18
+    #: Fewest samples a thread gets: below, starting it costs more than it saves.
+    MIN_CHUNK = 4096
 
     def __init__(self, variant: Variant) -> None:
         from rpr3gen import cbackend
@@ -116,15 +188,33 @@ class CEvaluator:
         params: np.ndarray,
         inputs: Sequence[np.ndarray],
         outputs: Sequence[np.ndarray],
-    ) -> None:
+        threads: int = 1,
+    ) -> int:
         public = [o for o, info in zip(outputs, function.outputs, strict=True) if not info.hidden]
         for out in public:
             if not out.flags.c_contiguous:
                 raise InputError("outputs of the c backend must be C-contiguous (n, size) arrays")
         batch = self.library.entries[function.name].batch
+        arrays = [*inputs, *public]
         n = inputs[0].shape[0]
-        batch(params.ctypes.data, n, *(a.ctypes.data for a in inputs),
-              *(o.ctypes.data for o in public))  # fmt: skip
+        chunks = max(1, min(threads, n // self.MIN_CHUNK))
+        bounds = [n * k // chunks for k in range(chunks + 1)]
+
+        def part(lo: int, hi: int) -> int:  # ctypes releases the GIL for the call
+            return int(
+                batch(
+                    params.ctypes.data,
+                    hi - lo,
+                    *(a.ctypes.data + lo * a.strides[0] for a in arrays),
+                )
+            )
+
+        if chunks == 1:
+            return part(0, n)
+        pool = _pool(chunks)
+        return sum(
+            f.result() for f in [pool.submit(part, lo, hi) for lo, hi in itertools.pairwise(bounds)]
+        )
 
 
 _EVALUATORS: dict[tuple[str, str], Evaluator] = {}

@@ -3,7 +3,10 @@
 Per function ``f`` of a module with prefix ``p``: ``int p_f(params, inputs..., outputs...)`` for
 one sample (outputs untouched unless it returns ``P_OK``) and ``size_t p_f_batch(params, n,
 inputs..., outputs...)`` over n row-major samples, evaluated in three passes so that the
-compiler vectorises the arithmetic (:mod:`.batch`). Both run the same statements.
+compiler vectorises them (:mod:`.batch`). Both run the same statements and the same math
+kernels (:mod:`rpr3gen_derive.codegen.mathkernels`); a batch sample that fails a check, or
+whose ``sin``/``cos`` argument is beyond the kernels' fast path, is evaluated again by the
+single-sample kernel.
 """
 
 from __future__ import annotations
@@ -11,8 +14,9 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 import jinja2
+from rpr3gen_derive.codegen import mathkernels
 from rpr3gen_derive.codegen.backends.c.batch import NotSplittableError, plan
-from rpr3gen_derive.codegen.backends.c.printer import c_code
+from rpr3gen_derive.codegen.backends.c.printer import c_code, fast_trig_arguments
 from rpr3gen_derive.codegen.spec import ModuleSpec
 
 if TYPE_CHECKING:
@@ -45,8 +49,8 @@ def comment(text: str, first: str, rest: str, width: int = WIDTH - 4) -> str:
     return "\n".join(lines)
 
 
-def _lines(statements: Any) -> list[tuple[str, str]]:
-    return [(str(lhs), c_code(rhs)) for lhs, rhs in statements]
+def _lines(statements: Any, prefix: str, fast: bool = False) -> list[tuple[str, str]]:
+    return [(str(lhs), c_code(rhs, prefix, fast)) for lhs, rhs in statements]
 
 
 def _function(module: ModuleSpec, c: Compiled) -> dict[str, Any]:
@@ -62,8 +66,8 @@ def _function(module: ModuleSpec, c: Compiled) -> dict[str, Any]:
         p = None
     slot = dict(enumerate(c.slots))
 
-    def outputs(indexed: Any) -> list[tuple[str, int, str]]:
-        return [(*slot[k], c_code(e)) for k, e in indexed]
+    def outputs(indexed: Any, fast: bool = False) -> list[tuple[str, int, str]]:
+        return [(*slot[k], c_code(e, prefix, fast)) for k, e in indexed]
 
     sizes = {
         o.name: f"{upper}_{table_count(o.table)}" if o.table else str(o.size) for o in spec.outputs
@@ -110,7 +114,7 @@ def _function(module: ModuleSpec, c: Compiled) -> dict[str, Any]:
         "sizes": sizes,
         "used_params": c.used_params,
         "used_inputs": c.used_inputs,
-        "assignments": _lines(c.code.assignments),
+        "assignments": _lines(c.code.assignments, prefix),
         "outputs": outputs(enumerate(e for _, e in c.code.outputs)),
         "input_code": input_code,
         "custom_code": custom_code,
@@ -119,20 +123,26 @@ def _function(module: ModuleSpec, c: Compiled) -> dict[str, Any]:
         "context": dict(spec.c_context),
         "ops_before": c.code.ops_before,
         "ops_after": c.code.ops_after,
-        "batch": None
-        if p is None
-        else {
-            "constants": _lines(p.constants),
-            "pass_a": _lines(p.pass_a),
-            "pass_b": _lines(p.pass_b),
-            "pass_c": _lines(p.pass_c),
-            "a_arrays": sorted({str(s) for s in p.a_to_b + p.a_to_c}),
-            "a_to_b": [str(s) for s in p.a_to_b],
-            "a_to_c": [str(s) for s in p.a_to_c],
-            "b_to_c": [str(s) for s in p.b_to_c],
-            "outputs_b": outputs(p.outputs_b),
-            "outputs_c": outputs(p.outputs_c),
-        },
+        "batch": None if p is None else _batch(prefix, p, outputs),
+    }
+
+
+def _batch(prefix: str, p: Any, outputs: Any) -> dict[str, Any]:
+    """Template context of a function's three-pass batch (:mod:`.batch`)."""
+    fast_exprs = [e for _, e in p.pass_b] + [e for _, e in p.outputs_b]
+    return {
+        "constants": _lines(p.constants, prefix),
+        "pass_a": _lines(p.pass_a, prefix),
+        "pass_b": _lines(p.pass_b, prefix, fast=True),
+        "pass_c": _lines(p.pass_c, prefix),
+        "a_arrays": sorted({str(s) for s in p.a_to_b + p.a_to_c}),
+        "a_to_b": [str(s) for s in p.a_to_b],
+        "a_to_c": [str(s) for s in p.a_to_c],
+        "b_to_c": [str(s) for s in p.b_to_c],
+        "outputs_b": outputs(p.outputs_b, fast=True),
+        "outputs_c": outputs(p.outputs_c),
+        # sin/cos arguments of pass B: beyond the fast path, the sample is evaluated again
+        "fast_trig": [c_code(arg, prefix) for arg in fast_trig_arguments(fast_exprs)],
     }
 
 
@@ -153,6 +163,9 @@ def render(
     for c in compiled:
         tables += [(table_count(o.table), o) for o in c.spec.outputs if o.table]
     uses_finite = any(f["input_code"] or f["checks"] for f in functions)
+    kernels = mathkernels.used(
+        e for c in compiled for e in [rhs for _, rhs in c.code.assignments + c.code.outputs]
+    )
     context = {
         "module": module,
         "functions": functions,
@@ -164,6 +177,7 @@ def render(
         "ops_before": sum(f["ops_before"] for f in functions),
         "ops_after": sum(f["ops_after"] for f in functions),
         "assignments": sum(len(f["assignments"]) for f in functions),
+        "math": mathkernels.context(kernels),
     }
     with stage("render"):
         header = env.get_template("backends/c/templates/header.h.jinja").render(context)

@@ -1,14 +1,16 @@
 """Partition a straight-line program for the C batch loop, so that the compiler can vectorise it.
 
-Calls into libm (sin, cos, sqrt, atan2, nearbyint) keep a loop scalar. The batch function
-therefore evaluates a block of samples in three passes:
+A call into libm keeps a loop scalar. The generated C has kernels of its own for everything the
+derivations use (``sin``, ``cos``, ``atan2``, ``Min``, ``Max``, the rounding of ``wrap_angle``:
+:mod:`rpr3gen_derive.codegen.mathkernels`; ``sqrt`` and ``fabs`` are instructions), so with
+them every statement vectorises; any other call (``exp``, ``pow``...) would not. The batch
+function therefore evaluates a block of samples in three passes:
 
-A. scalar, per sample: the statements that call libm early (in a robot: the pose, sin/cos of an
-   angle, lengths and angles) and what they depend on; their results go to block arrays;
-B. per sample, arithmetic only: everything else, in a loop with no calls, which the compiler
-   vectorises across samples (structure of arrays, no aliasing);
-C. scalar, per sample: the few late calls (the square root of the conditioning), the validity
-   checks and the row-major stores.
+A. scalar, per sample: the inputs, and the statements that call libm early and what they depend
+   on (none, with the kernels); their results go to block arrays;
+B. per sample, no libm calls: everything else, in a loop that the compiler vectorises across
+   samples (structure of arrays, no aliasing);
+C. scalar, per sample: the late libm calls, the validity checks and the row-major stores.
 """
 
 from __future__ import annotations
@@ -17,17 +19,27 @@ from dataclasses import dataclass
 
 import sympy as sp
 from rpr3gen_derive.codegen.cse import StraightLine
+from rpr3gen_derive.codegen.functions import wrap_angle
 
 #: A call whose dependencies number more than this is late (pass C), not early (pass A).
 EARLY_LIMIT = 20
 
 
+#: Functions printed as instructions or as the generated C's own kernels: they vectorise.
+VECTORISABLE = (sp.Abs, sp.sin, sp.cos, sp.atan2, sp.Min, sp.Max, wrap_angle)
+
+
 def calls_libm(expr: sp.Expr) -> bool:
-    """True if printing ``expr`` in C calls a math function that blocks vectorisation."""
+    """True if printing ``expr`` in C calls a math function that blocks vectorisation.
+
+    ``sqrt`` vectorises where ``errno`` is off (``-fno-math-errno``, as the runtime builds);
+    other powers that are not products become ``pow``.
+    """
     for node in sp.preorder_traversal(expr):
-        if isinstance(node, sp.Function) and not isinstance(node, sp.Abs):
+        if isinstance(node, sp.Function) and not isinstance(node, VECTORISABLE):
             return True
-        if node.is_Pow and node.exp in (sp.Rational(1, 2), sp.Rational(-1, 2)):
+        small = node.is_Pow and node.exp.is_Integer and abs(node.exp) <= 3
+        if node.is_Pow and not (small or abs(node.exp) == sp.Rational(1, 2)):
             return True
     return False
 

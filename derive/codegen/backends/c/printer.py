@@ -2,9 +2,17 @@
 
 Squares and small integer powers are expanded to products by SymPy's rewriting passes before
 printing (:func:`rpr3gen_derive.codegen.backends.prepare`), so no ``pow`` is emitted for them.
+``sin``, ``cos``, ``atan2``, ``Min``, ``Max`` and the rounding of ``wrap_angle`` are printed as
+calls of the generated C's own inline kernels (:mod:`rpr3gen_derive.codegen.mathkernels`),
+``{prefix}_sin`` etc., so that loops over samples vectorise. In the batch loops
+(``fast=True``) ``sin`` and ``cos`` are the kernels' fast path (``{prefix}_sin_fast``), valid
+below ``mathkernels.FAST_LIMIT``; the batch flags larger arguments
+(:func:`fast_trig_arguments`).
 """
 
 from __future__ import annotations
+
+from functools import cache
 
 import sympy as sp
 from rpr3gen_derive.codegen.backends import prepare
@@ -13,20 +21,57 @@ from sympy.printing.c import C99CodePrinter
 
 
 class CPrinter(C99CodePrinter):
-    """C99 code on ``double``."""
+    """C99 code on ``double``, with the module's math kernels named ``{prefix}_*``."""
 
-    def __init__(self) -> None:
-        super().__init__({"math_macros": {}})
+    def __init__(self, prefix: str, fast: bool = False) -> None:
+        trig = "_fast" if fast else ""
+        super().__init__(
+            {
+                "math_macros": {},
+                "user_functions": {
+                    "sin": f"{prefix}_sin{trig}",
+                    "cos": f"{prefix}_cos{trig}",
+                    "atan2": f"{prefix}_atan2",
+                },
+            }
+        )
+        self.prefix = prefix
 
     def _print_wrap_angle(self, expr: sp.Expr) -> str:
         # x - 2 pi round(x / 2 pi): a few flops, where glibc's remainder() costs ~40 ns.
         x = self._print(expr.args[0])
-        return f"(({x}) - {TWO_PI}*nearbyint(({x})*{INV_TWO_PI}))"
+        return f"(({x}) - {TWO_PI}*{self.prefix}_rint(({x})*{INV_TWO_PI}))"
+
+    def _fold(self, name: str, expr: sp.Expr) -> str:
+        args = [self._print(a) for a in expr.args]
+        text = args[-1]
+        for arg in reversed(args[:-1]):
+            text = f"{self.prefix}_{name}({arg}, {text})"
+        return text
+
+    def _print_Min(self, expr: sp.Expr) -> str:
+        return self._fold("fmin", expr)
+
+    def _print_Max(self, expr: sp.Expr) -> str:
+        return self._fold("fmax", expr)
 
 
-_PRINTER = CPrinter()  # stateless between calls; built once, it is most of a call's cost
+@cache
+def _printer(prefix: str, fast: bool) -> CPrinter:
+    # Stateless between calls; built once per prefix, it is most of a call's cost.
+    return CPrinter(prefix, fast)
 
 
-def c_code(expr: sp.Expr) -> str:
-    """One C99 expression."""
-    return _PRINTER.doprint(prepare(expr))
+def c_code(expr: sp.Expr, prefix: str, fast: bool = False) -> str:
+    """One C99 expression; ``fast``: the batch loops' form (see the module docstring)."""
+    return _printer(prefix, fast).doprint(prepare(expr))
+
+
+def fast_trig_arguments(exprs: list[sp.Expr]) -> list[sp.Expr]:
+    """The distinct arguments of ``sin`` and ``cos`` in ``exprs``, in order of appearance."""
+    found: list[sp.Expr] = []
+    for expr in exprs:
+        for node in sp.preorder_traversal(expr):
+            if isinstance(node, (sp.sin, sp.cos)) and node.args[0] not in found:
+                found.append(node.args[0])
+    return found

@@ -9,6 +9,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 import jinja2
+from rpr3gen_derive.codegen import mathkernels
 from rpr3gen_derive.codegen.backends.python.lowering import lower_numpy
 from rpr3gen_derive.codegen.spec import ModuleSpec
 
@@ -59,6 +60,9 @@ def render(
             functions=functions,
             tables=tables,
             source_hash=digest,
+            sincos=any(f["lowered"].sincos for f in functions),
+            sin_coefficients=[mathkernels.literal(c) for c in mathkernels.SIN],
+            cos_coefficients=[mathkernels.literal(c) for c in mathkernels.COS],
             ops_before=sum(c.code.ops_before for c in compiled),
             ops_after=sum(c.code.ops_after for c in compiled),
             assignments=sum(len(c.code.assignments) for c in compiled),

@@ -5,6 +5,12 @@ allocated once per call; a row is reused as soon as the value in it is dead, so 
 of a block of samples stays in cache and no temporary array is allocated per operation.
 Subexpressions of parameters only are computed once per call as Python scalars. Outputs that
 are named intermediates are computed straight into their row of ``out``.
+
+Every ufunc call costs a pass over the block and a fixed ~0.3 us of dispatch, so the lowering
+first folds away the assignments that are only a copy or a negation of another value
+(``x1 = -L``, ``omega = x6``): substituted into their uses, SymPy's own simplification turns
+``-x1 - c`` into ``L - c``, one call instead of three. The C code keeps them (its compiler
+folds them).
 """
 
 from __future__ import annotations
@@ -21,11 +27,35 @@ _UFUNC = {sp.cos: "cos", sp.sin: "sin", sp.Abs: "absolute", sp.atan2: "arctan2"}
 
 @dataclass
 class LoweredNumpy:
-    """Lines of the generated function body, and the size of its work array."""
+    """Lines of the generated function body, the size of its work array, and whether it calls
+    the module's ``_sincos`` helper."""
 
     scalar_lines: list[str]
     vector_lines: list[str]
     buffers: int
+    sincos: bool = False
+
+
+#: Work rows the module's ``_sincos(x, s, c, work)`` helper takes.
+SINCOS_WORK = 4
+
+
+def trig_pairs(statements: list[tuple[sp.Symbol, sp.Expr]]) -> dict[sp.Symbol, sp.Symbol]:
+    """``{first: second}`` for each ``s = sin(a)``, ``c = cos(a)`` pair of statements: evaluated
+    together by ``_sincos`` (NumPy's ``sin`` and ``cos`` cost ~10 ns a value each; the pair,
+    ~50 ufunc passes of the C kernels' reduction and polynomials, about half of that)."""
+    found: dict[tuple[type, sp.Expr], sp.Symbol] = {}
+    for lhs, rhs in statements:
+        if isinstance(rhs, (sp.sin, sp.cos)):
+            found.setdefault((type(rhs), rhs.args[0]), lhs)
+    pairs = {}
+    for (func, arg), lhs in found.items():
+        if func is sp.sin and (sp.cos, arg) in found:
+            other = found[(sp.cos, arg)]
+            order = [s for s, _ in statements]
+            first, second = sorted((lhs, other), key=order.index)
+            pairs[first] = second
+    return pairs
 
 
 @dataclass
@@ -222,6 +252,31 @@ class _Lowering:
         return self.call("power", [self.emit(base), self.scalar(exponent)], dest)
 
 
+def _is_copy_or_negation(expr: sp.Expr) -> bool:
+    return expr.is_Symbol or (expr.is_Mul and len(expr.args) == 2 and expr.args[0] == -1
+                              and expr.args[1].is_Symbol)  # fmt: skip
+
+
+def fold_copies(
+    code: StraightLine, scalars: set[sp.Symbol]
+) -> tuple[list[tuple[sp.Symbol, sp.Expr]], list[tuple[str, sp.Expr]]]:
+    """``code``'s assignments and outputs with every per-sample copy or negation of another
+    value substituted into its uses (in order, so chains fold too)."""
+    scalar = set(scalars)
+    folded: dict[sp.Symbol, sp.Expr] = {}
+    statements = []
+    for lhs, rhs in code.assignments:
+        rhs = rhs.xreplace(folded) if folded else rhs
+        if rhs.free_symbols <= scalar:
+            scalar.add(lhs)
+        elif _is_copy_or_negation(rhs):
+            folded[lhs] = rhs
+            continue
+        statements.append((lhs, rhs))
+    outputs = [(name, expr.xreplace(folded)) for name, expr in code.outputs]
+    return statements, outputs
+
+
 def lower_numpy(
     code: StraightLine,
     inputs: dict[sp.Symbol, str],
@@ -229,38 +284,56 @@ def lower_numpy(
     output_rows: dict[str, str],
 ) -> LoweredNumpy:
     """Lower ``code`` given where inputs live (``{x: "x"}``) and each output's row text."""
-    statements = list(code.assignments)
+    statements, outputs = fold_copies(code, params)
     # Output rows: an output that is a named intermediate is computed in place.
     alias: dict[sp.Symbol, str] = {}
-    for name, expr in code.outputs:
+    for name, expr in outputs:
         if expr.is_Symbol and expr not in alias and expr not in inputs:
             alias[expr] = output_rows[name]
     uses: dict[sp.Symbol, int] = {}  # index of each symbol's last use
     for index, (_, rhs) in enumerate(statements):
         for sym in rhs.free_symbols:
             uses[sym] = index
-    for _, expr in code.outputs:  # read by an output: alive to the end
+    for _, expr in outputs:  # read by an output: alive to the end
         for sym in expr.free_symbols:
             uses[sym] = len(statements)
     state = _Lowering(scalars=set(params))
     state.location.update(inputs)
     scalar_lines: list[str] = []
+    rhs_of = dict(statements)
+    pairs = {
+        a: b
+        for a, b in trig_pairs(statements).items()
+        if a not in alias and b not in alias and not state.is_scalar(rhs_of[a])
+    }
     for index, (lhs, rhs) in enumerate(statements):
         if state.is_scalar(rhs):
             state.scalars.add(lhs)
             scalar_lines.append(f"{lhs} = {numpy_code(rhs)}")
             continue
-        target = alias.get(lhs)
-        result = state.emit(rhs, target)
-        state.bind(lhs, result)
+        if lhs in pairs:  # sin and cos of one argument, both now
+            second = pairs[lhs]
+            x = state.emit(rhs.args[0])
+            rows = {type(rhs): state.new(), type(rhs_of[second]): state.new()}
+            work = [state.new() for _ in range(SINCOS_WORK)]
+            state.lines.append(
+                f"_sincos({x}, {rows[sp.sin]}, {rows[sp.cos]}, ({', '.join(work)},))"
+            )
+            for operand in (x, *work):
+                state.release(operand)
+            state.bind(lhs, rows[type(rhs)])
+            state.bind(second, rows[type(rhs_of[second])])
+        elif lhs not in pairs.values():
+            target = alias.get(lhs)
+            state.bind(lhs, state.emit(rhs, target))
         for sym in rhs.free_symbols:  # operands whose last use is this statement
             if uses.get(sym) == index:
                 state.drop(sym)
         if lhs not in uses:
             state.drop(lhs)
-    for name, expr in code.outputs:
+    for name, expr in outputs:
         row = output_rows[name]
         if expr.is_Symbol and alias.get(expr) == row:
             continue
         state.emit(expr, row)
-    return LoweredNumpy(scalar_lines, state.lines, state.count)
+    return LoweredNumpy(scalar_lines, state.lines, state.count, bool(pairs))
