@@ -246,8 +246,8 @@ def main() -> int:
         "",
         f"`python benchmarks/sweep_bench.py` at {commit}, {started}; {machine}, {cores} usable "
         f"cores, Python {platform.python_version()}. Load average {load_before[0]:.2f} before, "
-        f"{load_after[0]:.2f} after: **the machine is shared with other engineers' jobs, so every "
-        "figure is a lower bound of what the cores give alone.**",
+        f"{load_after[0]:.2f} after (the sweeps' own workers raise it; a load above 1 before "
+        "means other jobs shared the cores, and the figures are then lower bounds).",
         "",
         "Grid: `geometry.l0` x `mass.m3` of the paper robot, both paper trajectories (301 samples "
         f"each), workspace area on {AREA} x {AREA} points, chunks of 64 designs. Each run is a "
