@@ -29,7 +29,12 @@ from rpr3gen import manifest
 from rpr3gen.backends import evaluate
 from rpr3gen.control import platform_radius
 from rpr3gen.errors import IdentificationError, InputError
-from rpr3gen.identification import base_parameters, one_blas_thread, shared_matrix
+from rpr3gen.identification import (
+    base_parameters,
+    friction_columns_of_rates,
+    one_blas_thread,
+    shared_matrix,
+)
 from rpr3gen.model import LEGS, Model
 from rpr3gen.trajectory import Trajectory
 
@@ -178,12 +183,7 @@ def excite(
             Y = Y @ shared_matrix()
         W = Y[..., columns]
         if friction:  # the actuator rates are the inverse dynamics' omega10 or v21
-            rate = out[:, rate_columns]
-            extra = np.zeros((samples, 3, 6))
-            for i in range(3):
-                extra[:, i, i] = rate[:, i]
-                extra[:, i, 3 + i] = np.sign(rate[:, i])
-            W = np.concatenate([W, extra], axis=2)
+            W = np.concatenate([W, friction_columns_of_rates(out[:, rate_columns])], axis=2)
         return W.reshape(-1, W.shape[2]), out, codes, qdd
 
     def at(u: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:

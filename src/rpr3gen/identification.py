@@ -44,6 +44,7 @@ __all__ = [
     "base_parameters",
     "base_regressor",
     "friction_columns",
+    "friction_columns_of_rates",
     "friction_names",
     "identify",
     "inertial_parameters",
@@ -315,7 +316,7 @@ def base_regressor(
 # Least squares.
 
 
-def friction_names(model: Model) -> tuple[str, ...]:
+def friction_names() -> tuple[str, ...]:
     """Friction parameters per actuator: viscous ``fv_A..C`` then Coulomb ``fc_A..C``."""
     return tuple(f"fv_{leg}" for leg in LEGS) + tuple(f"fc_{leg}" for leg in LEGS)
 
@@ -325,7 +326,12 @@ def friction_columns(
 ) -> np.ndarray:
     """(n, 3, 6): effort of actuator i += fv_i qa'_i + fc_i sign(qa'_i), ``qa' = J q'``."""
     rate = np.einsum("nij,nj->ni", actuator_jacobian(model, q, backend), qd)
-    out = np.zeros((len(q), 3, 6))
+    return friction_columns_of_rates(rate)
+
+
+def friction_columns_of_rates(rate: np.ndarray) -> np.ndarray:
+    """:func:`friction_columns` from the actuator rates ``qa'`` (n, 3)."""
+    out = np.zeros((len(rate), 3, 6))
     for i in range(3):
         out[:, i, i] = rate[:, i]
         out[:, i, 3 + i] = np.sign(rate[:, i])
@@ -388,7 +394,22 @@ def _columns(
     friction: bool,
     backend: str,
 ) -> np.ndarray:
-    Y = regressor(model, q, qd, qdd, base.parameter_names == SHARED_PARAMETER_NAMES, backend)
+    Y, _ = _regressor_and_codes(model, q, qd, qdd, backend)
+    return _design(model, Y, q, qd, base, friction, backend)
+
+
+def _design(
+    model: Model,
+    Y: np.ndarray,
+    q: np.ndarray,
+    qd: np.ndarray,
+    base: BaseParameters,
+    friction: bool,
+    backend: str,
+) -> np.ndarray:
+    """The columns of the fit (n, 3, B [+ 6]) from the per-leg regressor Y (n, 3, 28)."""
+    if base.parameter_names == SHARED_PARAMETER_NAMES:
+        Y = Y @ shared_matrix()
     Yb = Y[..., list(base.columns)]
     if friction:
         Yb = np.concatenate([Yb, friction_columns(model, q, qd, backend)], axis=2)
@@ -483,13 +504,8 @@ def identify(
             f"{where(int(bad[0]))}: {reason.get(int(codes[bad[0]]), 'refused')} "
             f"({bad.size} of {n} samples refused)"
         )
-    if identical_legs:
-        Y = Y @ shared_matrix()
-    columns = Y[..., list(base.columns)]
-    names = base.names
-    if friction:
-        columns = np.concatenate([columns, friction_columns(model, q, qd, backend)], axis=2)
-        names = names + friction_names(model)
+    columns = _design(model, Y, q, qd, base, friction, backend)
+    names = base.names + (friction_names() if friction else ())
     p = len(names)
     if 3 * n <= p:
         raise IdentificationError(
