@@ -639,7 +639,9 @@ def _platform_point_motion(q, qd, qdd, p):
     return x, v, a
 
 
-def leg_motion(robot: Robot, q: Any, qd: Any, qdd: Any = None) -> LegMotion:
+def leg_motion(
+    robot: Robot, q: Any, qd: Any, qdd: Any = None, qlegs: list[np.ndarray] | None = None
+) -> LegMotion:
     """Inverse kinematics to second order: joint coordinates, rates and accelerations.
 
     With ``Js`` the serial Jacobian (:func:`serial_jacobian`) and ``X3`` joint 3's point:
@@ -650,6 +652,8 @@ def leg_motion(robot: Robot, q: Any, qd: Any, qdd: Any = None) -> LegMotion:
     Args:
         robot: the robot.
         q, qd, qdd: (n, 3) platform pose, velocity, acceleration (qdd None = zeros).
+        qlegs: the legs' working-mode joint coordinates at ``q`` if already known
+            (:func:`inverse_kinematics`), else None.
 
     Returns:
         The legs' joint motion and chains (chains evaluated with the computed rates and
@@ -658,7 +662,8 @@ def leg_motion(robot: Robot, q: Any, qd: Any, qdd: Any = None) -> LegMotion:
     q = _as_pose(q)
     qd = np.broadcast_to(np.asarray(qd, dtype=float), q.shape)
     qdd = np.zeros_like(q) if qdd is None else np.broadcast_to(np.asarray(qdd, float), q.shape)
-    qlegs = inverse_kinematics(robot, q)
+    if qlegs is None:
+        qlegs = inverse_kinematics(robot, q)
     out = LegMotion([], [], [], [])
     for i in range(3):
         qj = qlegs[i]
@@ -689,7 +694,7 @@ def _wrench_rows(f: np.ndarray, m: np.ndarray, X: np.ndarray, C: np.ndarray) -> 
 
 
 def newton_euler_system(
-    robot: Robot, q: Any, qd: Any, qdd: Any
+    robot: Robot, q: Any, qd: Any, qdd: Any, qlegs: list[np.ndarray] | None = None
 ) -> tuple[np.ndarray, np.ndarray, LegMotion]:
     """The 21 x 21 Newton-Euler system ``A x = b`` of the seven bodies.
 
@@ -703,6 +708,7 @@ def newton_euler_system(
     Args:
         robot: the robot.
         q, qd, qdd: (n, 3) platform motion.
+        qlegs: the legs' joint coordinates at ``q`` if already known, else None.
 
     Returns:
         ``A`` (n, 21, 21), ``b`` (n, 21) and the legs' motion.
@@ -711,7 +717,7 @@ def newton_euler_system(
     qd = np.broadcast_to(np.asarray(qd, dtype=float), q.shape)
     qdd = np.broadcast_to(np.asarray(qdd, dtype=float), q.shape)
     n = q.shape[0]
-    motion = leg_motion(robot, q, qd, qdd)
+    motion = leg_motion(robot, q, qd, qdd, qlegs)
     A = np.zeros((n, 21, 21))
     b = np.zeros((n, 21))
     g = robot.gravity
@@ -906,7 +912,10 @@ def actuator_jacobian(robot: Robot, q: Any) -> np.ndarray:
     joint 3's point: ``J[L] = (Js^-1 K)[actuated - 1]``.
     """
     q = _as_pose(q)
-    qlegs = inverse_kinematics(robot, q)
+    return _actuator_jacobian(robot, q, inverse_kinematics(robot, q))
+
+
+def _actuator_jacobian(robot: Robot, q: np.ndarray, qlegs: list[np.ndarray]) -> np.ndarray:
     rows = []
     for i in range(3):
         Js = serial_jacobian(robot, i, np.where(np.isfinite(qlegs[i]), qlegs[i], 0.0))
@@ -941,25 +950,35 @@ def task_space(robot: Robot, q: Any, qd: Any) -> tuple[np.ndarray, np.ndarray]:
     Returns:
         ``M`` (n, 3, 3) and ``c`` (n, 3).
     """
+    M, c, _ = _task_space(robot, _as_pose(q), qd)
+    return M, c
+
+
+def _task_space(robot: Robot, q: np.ndarray, qd: Any) -> tuple[np.ndarray, ...]:
+    """M, c and J at (q, qd): one Newton-Euler system of 4 n samples (qdd = 0, e1, e2, e3)."""
     _refuse_singular(robot)
-    q = _as_pose(q)
     qd = np.broadcast_to(np.asarray(qd, dtype=float), q.shape)
     n = q.shape[0]
-    zero = np.zeros_like(q)
-    A, b0, _ = newton_euler_system(robot, q, qd, zero)
-    bs = [b0]
+    qlegs = inverse_kinematics(robot, q)
+    qdd = np.zeros((4, n, 3))
     for k in range(3):
-        e = zero.copy()
-        e[:, k] = 1.0
-        bs.append(newton_euler_system(robot, q, qd, e)[1] - b0)
-    x = _solve_system(A, np.stack(bs, axis=2))  # (n, 21, 4)
+        qdd[k + 1, :, k] = 1.0
+    A, b, _ = newton_euler_system(
+        robot,
+        np.tile(q, (4, 1)),
+        np.tile(qd, (4, 1)),
+        qdd.reshape(4 * n, 3),
+        [np.tile(x, (4, 1)) for x in qlegs],
+    )
+    b = b.reshape(4, n, 21)
+    rhs = np.stack([b[0], b[1] - b[0], b[2] - b[0], b[3] - b[0]], axis=2)  # (n, 21, 4)
+    x = _solve_system(A[:n], rhs)
     tau = x[:, [6, 13, 20], :]  # (n, 3 legs, 4)
-    J = actuator_jacobian(robot, q)
+    J = _actuator_jacobian(robot, q, qlegs)
     Jt = np.swapaxes(J, 1, 2)
     M = Jt @ tau[:, :, 1:]
     c = (Jt @ tau[:, :, :1])[..., 0]
-    assert M.shape == (n, 3, 3)
-    return M, c
+    return M, c, J
 
 
 def mass_matrix_from_energy(robot: Robot, q: Any) -> np.ndarray:
@@ -987,8 +1006,7 @@ def forward_dynamics(robot: Robot, q: Any, qd: Any, tau: Any) -> np.ndarray:
     """Platform acceleration ``qdd = M^-1 (J^T tau - c)``, (n, 3)."""
     q = _as_pose(q)
     tau = np.broadcast_to(np.asarray(tau, dtype=float), q.shape)
-    M, c = task_space(robot, q, qd)
-    J = actuator_jacobian(robot, q)
+    M, c, J = _task_space(robot, q, qd)
     rhs = (np.swapaxes(J, 1, 2) @ tau[..., None])[..., 0] - c
     return np.linalg.solve(M, rhs[..., None])[..., 0]
 
