@@ -76,7 +76,10 @@ def wrap_to_pi(angle: Any) -> np.ndarray:
 
 def _perp(a: np.ndarray) -> np.ndarray:
     """``a`` turned by +90 deg about z0 (``z0 x a``), last axis = (x0, y0)."""
-    return np.stack([-a[..., 1], a[..., 0]], axis=-1)
+    out = np.empty(np.shape(a))
+    out[..., 0] = -a[..., 1]
+    out[..., 1] = a[..., 0]
+    return out
 
 
 def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -91,8 +94,11 @@ def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 def _rotate(theta: np.ndarray, v: np.ndarray) -> np.ndarray:
     """``R(theta) v`` for angles (n,) and vectors (2,) or (n, 2) -> (n, 2)."""
     c, s = np.cos(theta), np.sin(theta)
-    v = np.broadcast_to(v, (*np.shape(theta), 2))
-    return np.stack([c * v[..., 0] - s * v[..., 1], s * v[..., 0] + c * v[..., 1]], axis=-1)
+    v = np.asarray(v, dtype=float)
+    out = np.empty((*np.shape(theta), 2))
+    out[..., 0] = c * v[..., 0] - s * v[..., 1]
+    out[..., 1] = s * v[..., 0] + c * v[..., 1]
+    return out
 
 
 def _angle(v: np.ndarray) -> np.ndarray:
