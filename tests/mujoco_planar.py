@@ -85,7 +85,7 @@ def _inertial_xml(com: np.ndarray, mass: float, inertia: float) -> str:
 
 
 def build_mjcf(
-    robot: pr.Robot,
+    robot: pr.RobotLike,
     *,
     timestep: float = TIMESTEP,
     integrator: str = "RK4",
@@ -104,6 +104,7 @@ def build_mjcf(
     Returns:
         The MJCF XML; ``qpos0`` (all zeros) is home, every loop closed.
     """
+    robot = pr.as_robot(robot)
     check_supported(robot)
     legs = []
     for name, leg in zip(LEGS, robot.legs, strict=True):

@@ -218,10 +218,11 @@ def sinusoids(
     return q, qd, qdd
 
 
-def motion_ok(robot: pr.Robot, q: np.ndarray) -> bool:
+def motion_ok(robot: pr.RobotLike, q: np.ndarray) -> bool:
     """True when every sample is reachable in the working mode with normalised ``|D|`` at least
     :data:`SERIAL_MIN_MOTION` and the scaled actuator Jacobian's condition number at most
     :data:`PARALLEL_MAX_COND_MOTION`."""
+    robot = pr.as_robot(robot)
     return _serial_ok(robot, q, SERIAL_MIN_MOTION) and _parallel_ok(
         robot, q, PARALLEL_MAX_COND_MOTION
     )
@@ -229,7 +230,7 @@ def motion_ok(robot: pr.Robot, q: np.ndarray) -> bool:
 
 def random_motion(
     rng: np.random.Generator,
-    robot: pr.Robot,
+    robot: pr.RobotLike,
     t: np.ndarray,
     amp: tuple[float, float, float] = (0.04, 0.04, 0.3),
     attempts: int = 60,
@@ -243,6 +244,7 @@ def random_motion(
     Returns:
         q, qd, qdd (n, 3).
     """
+    robot = pr.as_robot(robot)
     scale = 1.0
     for k in range(attempts):
         if k and k % 10 == 0:
@@ -319,7 +321,7 @@ def paper_twin(paper_params: Mapping[str, float], actuation: str) -> dict[str, A
 
 
 def paper_outputs(
-    general_outputs: Mapping[str, np.ndarray], robot: pr.Robot, q: Any
+    general_outputs: Mapping[str, np.ndarray], robot: pr.RobotLike, q: Any
 ) -> dict[str, np.ndarray]:
     """The general outputs of a :func:`paper_twin` robot under the paper's names.
 
@@ -330,10 +332,11 @@ def paper_outputs(
 
     Args:
         general_outputs: :func:`planar_reference.solve`'s outputs.
-        robot: the parsed twin.
+        robot: the twin (parsed or its dict).
         q: (n, 3) the platform poses of the outputs.
     """
     o = general_outputs
+    robot = pr.as_robot(robot)
     pts = pr.joint_points(robot, q)
     out: dict[str, np.ndarray] = {}
     for leg in LEGS:

@@ -31,6 +31,22 @@ Newton-Euler: seven bodies (two per leg and the platform), three equations each 
 moment about the centre of mass), 21 unknowns (two constraint components per joint: ``fx, fy``
 for R, the normal force and the moment for P; and the three efforts), one dense 21 x 21 solve
 per sample.
+
+Choices where the specification leaves room:
+
+- Angle branches: a leg's R coordinates but its last one are in ``(-pi, pi]``; the last is
+  ``phi`` minus the others, so they sum to ``phi`` exactly. Compare angles modulo 2 pi
+  (:func:`wrap_to_pi`).
+- Inverse kinematics in closed form per leg type (circle intersection, quadratic, or 2 x 2
+  linear system); of the (at most two) solutions the one whose serial determinant has its home
+  sign. A pose a leg cannot reach that way gives NaN rows (no exception).
+- Joint rates and accelerations from the serial Jacobian of the chain (no finite differences).
+- Architecturally singular structures parse, but :func:`solve`, :func:`task_space` and
+  :func:`forward_dynamics` refuse them (ValueError); :func:`newton_euler_system` still builds
+  their (singular) system.
+- The control form (:func:`task_space`, :func:`forward_dynamics`) comes from the Newton-Euler
+  solve (``tau`` is affine in ``qdd``); :func:`mass_matrix_from_energy` is an independent check.
+- Functions taking a robot accept a parsed :class:`Robot` or a model dict.
 """
 
 from __future__ import annotations
@@ -325,6 +341,15 @@ def parse_model(model: Mapping[str, Any]) -> Robot:
     return replace(robot, home_sign=np.sign(D))
 
 
+RobotLike = Robot | Mapping[str, Any]
+"""A parsed :class:`Robot` or a model dict (parsed on use)."""
+
+
+def as_robot(robot: RobotLike) -> Robot:
+    """``robot`` itself if already parsed, else :func:`parse_model` of the dict."""
+    return robot if isinstance(robot, Robot) else parse_model(robot)
+
+
 # ------------------------------------------------------------------------------------------------
 # Chain kinematics.
 
@@ -371,7 +396,13 @@ class Chain:
     axes: np.ndarray
 
 
-def chain(robot: Robot, i: int, qj: np.ndarray, qdj=None, qddj=None) -> Chain:
+def chain(
+    robot: Robot,
+    i: int,
+    qj: np.ndarray,
+    qdj: np.ndarray | None = None,
+    qddj: np.ndarray | None = None,
+) -> Chain:
     """Forward kinematics of leg ``i`` (0, 1, 2 for A, B, C) from its joint coordinates.
 
     Args:
@@ -548,7 +579,7 @@ def _leg_candidates(robot: Robot, i: int, q: np.ndarray) -> np.ndarray:
     return out
 
 
-def inverse_kinematics(robot: Robot, q: Any) -> list[np.ndarray]:
+def inverse_kinematics(robot: RobotLike, q: Any) -> list[np.ndarray]:
     """Joint coordinates of each leg in the model's working mode.
 
     Convention for angles: every R coordinate of a leg but its last one is in ``(-pi, pi]``; the
@@ -563,16 +594,18 @@ def inverse_kinematics(robot: Robot, q: Any) -> list[np.ndarray]:
         Legs A, B, C: (n, 3) joint coordinates (rad for R, m for P); NaN rows where the leg cannot
         reach the pose in its working mode (no real solution, or ``D`` of the wrong sign/zero).
     """
+    robot = as_robot(robot)
     q = _as_pose(q)
     out = []
     for i in range(3):
         cand = _leg_candidates(robot, i, q)
         n = q.shape[0]
-        D = np.full((n, 2), np.nan)
-        for k in range(2):
-            ok = np.all(np.isfinite(cand[:, k]), axis=1)
-            if np.any(ok):
-                D[ok, k] = np.linalg.det(serial_jacobian(robot, i, cand[ok, k]))
+        flat = cand.reshape(2 * n, 3)
+        ok = np.all(np.isfinite(flat), axis=1)
+        D = np.full(2 * n, np.nan)
+        if np.any(ok):
+            D[ok] = np.linalg.det(serial_jacobian(robot, i, flat[ok]))
+        D = D.reshape(n, 2)
         good = np.sign(D) == robot.home_sign[i]
         pick = np.where(good[:, 0], 0, 1)
         sol = cand[np.arange(n), pick]
@@ -599,7 +632,7 @@ def forward_chain_pose(robot: Robot, i: int, qj: np.ndarray) -> np.ndarray:
     return np.concatenate([G, ch.bodies[3].theta[:, None]], axis=1)
 
 
-def joint_points(robot: Robot, q: Any) -> dict[str, np.ndarray]:
+def joint_points(robot: RobotLike, q: Any) -> dict[str, np.ndarray]:
     """Current world points of joints 1, 2, 3 of each leg in the working mode.
 
     Args:
@@ -609,15 +642,17 @@ def joint_points(robot: Robot, q: Any) -> dict[str, np.ndarray]:
     Returns:
         ``{"A": (n, 3, 2), "B": ..., "C": ...}`` (NaN where unreachable).
     """
+    robot = as_robot(robot)
     qlegs = inverse_kinematics(robot, q)
     return {
         name: np.swapaxes(chain(robot, i, qlegs[i]).points, 0, 1) for i, name in enumerate(LEGS)
     }
 
 
-def serial_determinant(robot: Robot, q: Any) -> np.ndarray:
+def serial_determinant(robot: RobotLike, q: Any) -> np.ndarray:
     """Serial determinant ``D = det d(x3, y3, phi)/d(q1, q2, q3)`` of each leg in the working
     mode, (n, 3) (legs A, B, C; NaN where unreachable)."""
+    robot = as_robot(robot)
     return serial_determinant_at(robot, inverse_kinematics(robot, q))
 
 
@@ -628,12 +663,14 @@ class LegMotion:
     Attributes:
         q, qd, qdd: per leg (n, 3) joint coordinates, rates and accelerations.
         chains: per leg the :class:`Chain` at that motion.
+        serial: per leg the serial Jacobian (n, 3, 3) (:func:`serial_jacobian`).
     """
 
     q: list[np.ndarray]
     qd: list[np.ndarray]
     qdd: list[np.ndarray]
     chains: list[Chain]
+    serial: list[np.ndarray]
 
 
 def _platform_point_motion(q, qd, qdd, p):
@@ -646,7 +683,7 @@ def _platform_point_motion(q, qd, qdd, p):
 
 
 def leg_motion(
-    robot: Robot, q: Any, qd: Any, qdd: Any = None, qlegs: list[np.ndarray] | None = None
+    robot: RobotLike, q: Any, qd: Any, qdd: Any = None, qlegs: list[np.ndarray] | None = None
 ) -> LegMotion:
     """Inverse kinematics to second order: joint coordinates, rates and accelerations.
 
@@ -665,12 +702,13 @@ def leg_motion(
         The legs' joint motion and chains (chains evaluated with the computed rates and
         accelerations).
     """
+    robot = as_robot(robot)
     q = _as_pose(q)
     qd = np.broadcast_to(np.asarray(qd, dtype=float), q.shape)
     qdd = np.zeros_like(q) if qdd is None else np.broadcast_to(np.asarray(qdd, float), q.shape)
     if qlegs is None:
         qlegs = inverse_kinematics(robot, q)
-    out = LegMotion([], [], [], [])
+    out = LegMotion([], [], [], [], [])
     for i in range(3):
         qj = qlegs[i]
         bad = ~np.all(np.isfinite(qj), axis=1)
@@ -687,6 +725,7 @@ def leg_motion(
         out.qd.append(qdj)
         out.qdd.append(qddj)
         out.chains.append(chain(robot, i, qj, qdj, qddj))
+        out.serial.append(Js)
     return out
 
 
@@ -700,7 +739,7 @@ def _wrench_rows(f: np.ndarray, m: np.ndarray, X: np.ndarray, C: np.ndarray) -> 
 
 
 def newton_euler_system(
-    robot: Robot, q: Any, qd: Any, qdd: Any, qlegs: list[np.ndarray] | None = None
+    robot: RobotLike, q: Any, qd: Any, qdd: Any, qlegs: list[np.ndarray] | None = None
 ) -> tuple[np.ndarray, np.ndarray, LegMotion]:
     """The 21 x 21 Newton-Euler system ``A x = b`` of the seven bodies.
 
@@ -719,6 +758,7 @@ def newton_euler_system(
     Returns:
         ``A`` (n, 21, 21), ``b`` (n, 21) and the legs' motion.
     """
+    robot = as_robot(robot)
     q = _as_pose(q)
     qd = np.broadcast_to(np.asarray(qd, dtype=float), q.shape)
     qdd = np.broadcast_to(np.asarray(qdd, dtype=float), q.shape)
@@ -822,7 +862,7 @@ def _refuse_singular(robot: Robot) -> None:
         )
 
 
-def solve(robot: Robot, q: Any, qd: Any, qdd: Any) -> dict[str, np.ndarray]:
+def solve(robot: RobotLike, q: Any, qd: Any, qdd: Any) -> dict[str, np.ndarray]:
     """Inverse dynamics by Newton-Euler on the seven bodies.
 
     Args:
@@ -838,6 +878,7 @@ def solve(robot: Robot, q: Any, qd: Any, qdd: Any) -> dict[str, np.ndarray]:
     Raises:
         ValueError: for an architecturally singular structure.
     """
+    robot = as_robot(robot)
     _refuse_singular(robot)
     A, b, motion = newton_euler_system(robot, q, qd, qdd)
     return _outputs(robot, _solve_system(A, b), motion)
@@ -870,12 +911,13 @@ def _bodies(robot: Robot, motion: LegMotion, q, qd, qdd=None):
     yield robot.platform_mass, robot.platform_inertia, x, v, a, qd[:, 2], qdd[:, 2]
 
 
-def energy(robot: Robot, q: Any, qd: Any) -> np.ndarray:
+def energy(robot: RobotLike, q: Any, qd: Any) -> np.ndarray:
     """Kinetic plus potential energy of the seven bodies, (n,) J.
 
     Kinetic: ``m |v_com|^2 / 2 + J omega^2 / 2`` per body; potential ``-m g . r_com`` (zero at
     the world origin).
     """
+    robot = as_robot(robot)
     q = _as_pose(q)
     qd = np.broadcast_to(np.asarray(qd, dtype=float), q.shape)
     motion = leg_motion(robot, q, qd)
@@ -885,8 +927,9 @@ def energy(robot: Robot, q: Any, qd: Any) -> np.ndarray:
     return E
 
 
-def energy_rate(robot: Robot, q: Any, qd: Any, qdd: Any) -> np.ndarray:
+def energy_rate(robot: RobotLike, q: Any, qd: Any, qdd: Any) -> np.ndarray:
     """dE/dt analytically: ``sum m (a - g) . v + J alpha omega`` over the bodies, (n,) W."""
+    robot = as_robot(robot)
     q = _as_pose(q)
     qd = np.broadcast_to(np.asarray(qd, dtype=float), q.shape)
     qdd = np.broadcast_to(np.asarray(qdd, dtype=float), q.shape)
@@ -897,11 +940,12 @@ def energy_rate(robot: Robot, q: Any, qd: Any, qdd: Any) -> np.ndarray:
     return P
 
 
-def input_power(robot: Robot, out: Mapping[str, np.ndarray], qd: Any) -> np.ndarray:
+def input_power(robot: RobotLike, out: Mapping[str, np.ndarray], qd: Any) -> np.ndarray:
     """Power of the actuators and of the payload wrench at G, (n,) W.
 
     ``sum_L tau_L qd_actuated_L + F . v_G + mz dphi/dt``: equals dE/dt for correct loads.
     """
+    robot = as_robot(robot)
     qd = np.atleast_2d(np.asarray(qd, dtype=float))
     P = qd[:, :2] @ robot.payload_force + robot.payload_moment * qd[:, 2]
     return P + np.sum(efforts(out) * actuated_rates(robot, out), axis=1)
@@ -911,20 +955,29 @@ def input_power(robot: Robot, out: Mapping[str, np.ndarray], qd: Any) -> np.ndar
 # Control form: actuator Jacobian, task-space dynamics, forward dynamics.
 
 
-def actuator_jacobian(robot: Robot, q: Any) -> np.ndarray:
+def actuator_jacobian(robot: RobotLike, q: Any) -> np.ndarray:
     """``J = d qa / d q`` (n, 3, 3): row L is leg L's actuated joint rate per platform rate.
 
     From ``Js qd_leg = K qd`` with ``K = [[1, 0, -r_y], [0, 1, r_x], [0, 0, 1]]``, ``r`` from G to
     joint 3's point: ``J[L] = (Js^-1 K)[actuated - 1]``.
     """
+    robot = as_robot(robot)
     q = _as_pose(q)
     return _actuator_jacobian(robot, q, inverse_kinematics(robot, q))
 
 
-def _actuator_jacobian(robot: Robot, q: np.ndarray, qlegs: list[np.ndarray]) -> np.ndarray:
+def _actuator_jacobian(
+    robot: Robot,
+    q: np.ndarray,
+    qlegs: list[np.ndarray],
+    serial: list[np.ndarray] | None = None,
+) -> np.ndarray:
     rows = []
     for i in range(3):
-        Js = serial_jacobian(robot, i, np.where(np.isfinite(qlegs[i]), qlegs[i], 0.0))
+        if serial is None:
+            Js = serial_jacobian(robot, i, np.where(np.isfinite(qlegs[i]), qlegs[i], 0.0))
+        else:
+            Js = serial[i]
         r = _rotate(q[:, 2], robot.legs[i].joints[2])
         K = np.zeros((q.shape[0], 3, 3))
         K[:, 0, 0] = K[:, 1, 1] = K[:, 2, 2] = 1.0
@@ -936,10 +989,11 @@ def _actuator_jacobian(robot: Robot, q: np.ndarray, qlegs: list[np.ndarray]) -> 
     return np.stack(rows, axis=1)
 
 
-def scaled_actuator_jacobian(robot: Robot, q: Any) -> np.ndarray:
+def scaled_actuator_jacobian(robot: RobotLike, q: Any) -> np.ndarray:
     """:func:`actuator_jacobian` made dimensionless: the phi column times ``1/rho`` (platform
     radius) and, for R motors, every row times :attr:`Robot.scale`. Used for conditioning checks
     of random models (not the project's documented measure)."""
+    robot = as_robot(robot)
     J = actuator_jacobian(robot, q).copy()
     J[:, :, 2] /= robot.platform_radius
     if robot.leg[robot.actuated - 1] == "R":
@@ -947,7 +1001,7 @@ def scaled_actuator_jacobian(robot: Robot, q: Any) -> np.ndarray:
     return J
 
 
-def task_space(robot: Robot, q: Any, qd: Any) -> tuple[np.ndarray, np.ndarray]:
+def task_space(robot: RobotLike, q: Any, qd: Any) -> tuple[np.ndarray, np.ndarray]:
     """Dynamics in platform coordinates: ``M qdd + c = J^T tau``.
 
     ``tau`` from :func:`solve` is affine in ``qdd``: ``tau = T qdd + tau0``; then ``M = J^T T`` and
@@ -956,6 +1010,7 @@ def task_space(robot: Robot, q: Any, qd: Any) -> tuple[np.ndarray, np.ndarray]:
     Returns:
         ``M`` (n, 3, 3) and ``c`` (n, 3).
     """
+    robot = as_robot(robot)
     M, c, _ = _task_space(robot, _as_pose(q), qd)
     return M, c
 
@@ -969,7 +1024,7 @@ def _task_space(robot: Robot, q: np.ndarray, qd: Any) -> tuple[np.ndarray, ...]:
     qdd = np.zeros((4, n, 3))
     for k in range(3):
         qdd[k + 1, :, k] = 1.0
-    A, b, _ = newton_euler_system(
+    A, b, motion = newton_euler_system(
         robot,
         np.tile(q, (4, 1)),
         np.tile(qd, (4, 1)),
@@ -980,17 +1035,18 @@ def _task_space(robot: Robot, q: np.ndarray, qd: Any) -> tuple[np.ndarray, ...]:
     rhs = np.stack([b[0], b[1] - b[0], b[2] - b[0], b[3] - b[0]], axis=2)  # (n, 21, 4)
     x = _solve_system(A[:n], rhs)
     tau = x[:, [6, 13, 20], :]  # (n, 3 legs, 4)
-    J = _actuator_jacobian(robot, q, qlegs)
+    J = _actuator_jacobian(robot, q, qlegs, [Js[:n] for Js in motion.serial])
     Jt = np.swapaxes(J, 1, 2)
     M = Jt @ tau[:, :, 1:]
     c = (Jt @ tau[:, :, :1])[..., 0]
     return M, c, J
 
 
-def mass_matrix_from_energy(robot: Robot, q: Any) -> np.ndarray:
+def mass_matrix_from_energy(robot: RobotLike, q: Any) -> np.ndarray:
     """``M`` (n, 3, 3) from the kinetic energy alone: ``sum m Jv^T Jv + J Jw^T Jw`` over bodies,
     with each body's com-velocity and angular-velocity Jacobians (w.r.t. the platform rate) from
     the legs' velocity kinematics. Independent of the Newton-Euler solve."""
+    robot = as_robot(robot)
     q = _as_pose(q)
     n = q.shape[0]
     cols: list[list[tuple[float, float, np.ndarray, np.ndarray]]] = []
@@ -1008,8 +1064,9 @@ def mass_matrix_from_energy(robot: Robot, q: Any) -> np.ndarray:
     return M
 
 
-def forward_dynamics(robot: Robot, q: Any, qd: Any, tau: Any) -> np.ndarray:
+def forward_dynamics(robot: RobotLike, q: Any, qd: Any, tau: Any) -> np.ndarray:
     """Platform acceleration ``qdd = M^-1 (J^T tau - c)``, (n, 3)."""
+    robot = as_robot(robot)
     q = _as_pose(q)
     tau = np.broadcast_to(np.asarray(tau, dtype=float), q.shape)
     M, c, J = _task_space(robot, q, qd)
@@ -1052,7 +1109,7 @@ def _closure(robot: Robot, qa: np.ndarray, z: np.ndarray) -> tuple[np.ndarray, n
 
 
 def assembly_modes_bruteforce(
-    robot: Robot,
+    robot: RobotLike,
     qa: Any,
     *,
     starts: int = 96,
@@ -1083,6 +1140,7 @@ def assembly_modes_bruteforce(
     Returns:
         (k, 3) poses ``(x, y, phi)``, phi in ``(-pi, pi]``, sorted by phi then x.
     """
+    robot = as_robot(robot)
     qa = np.asarray(qa, dtype=float).reshape(3)
     rng = np.random.default_rng(seed)
     ja = robot.actuated - 1
