@@ -449,8 +449,9 @@ def _relative_smallest_singular_value(robot: pr.Robot, q: np.ndarray) -> np.ndar
 
 @pytest.mark.parametrize(("leg", "actuated"), list(pr.SINGULAR_STRUCTURES))
 def test_singular_structures_give_a_singular_system(leg: str, actuated: int) -> None:
-    """The 21 x 21 system is singular at every pose (measured 1e-17 relative) for the three
-    singular structures, while the same legs with another motor give a regular one (> 1e-4)."""
+    """The 21 x 21 system is singular at every pose for the three singular structures (smallest
+    singular value relative to the largest: measured 1e-16), while the same robot with another
+    motor gives a regular one (measured 0.04 to 0.06)."""
     rng = np.random.default_rng(7)
     model = pm.random_model_unchecked(rng, leg, actuated)
     robot = pr.parse_model(model)
@@ -461,7 +462,7 @@ def test_singular_structures_give_a_singular_system(leg: str, actuated: int) -> 
         pr.solve(robot, poses, np.zeros_like(poses), np.zeros_like(poses))
     other = next(a for a in (1, 2, 3) if a != actuated)
     regular = pr.parse_model({**model, "actuated": other})
-    assert np.all(_relative_smallest_singular_value(regular, poses) > 1e-6)
+    assert np.all(_relative_smallest_singular_value(regular, poses) > 1e-3)
 
 
 # -- symmetry -------------------------------------------------------------------------------------
