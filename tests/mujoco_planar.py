@@ -170,9 +170,10 @@ def build_mjcf(
 """
 
 
-def compile_model(robot: pr.Robot, **options: Any) -> tuple[Any, Any]:
+def compile_model(robot: pr.RobotLike, **options: Any) -> tuple[Any, Any]:
     """``(mujoco.MjModel, mujoco.MjData)`` of :func:`build_mjcf`, the payload in
     ``qfrc_applied`` (``options`` go to :func:`build_mjcf`)."""
+    robot = pr.as_robot(robot)
     import mujoco
 
     model = mujoco.MjModel.from_xml_string(build_mjcf(robot, **options))
