@@ -11,7 +11,7 @@ import sys
 from pathlib import Path
 
 from rpr3gen_derive.codegen.files import stale_files, write_files
-from rpr3gen_derive.rpr3 import generate
+from rpr3gen_derive.planar import generate
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -54,6 +54,7 @@ class Geometry:
     alpha: tuple[float, float, float]  # leg angles in the central configuration
     offset: float  # l0 + l2: leg length |A1A3| at lambda21 = 0
     rho: float  # RMS distance of the platform joints from G
+    l0: float = math.nan  # |A1A2| at lambda21 = 0: the scale of reach
 
     @classmethod
     def from_params(cls, params: Mapping[str, float]) -> Geometry:
@@ -66,7 +67,14 @@ class Geometry:
         platform = (point("A", 3), point("B", 3), point("C", 3))
         alpha = (float(params["alpha_A"]), float(params["alpha_B"]), float(params["alpha_C"]))
         rho = math.sqrt(sum(px * px + py * py for px, py in platform) / 3.0)
-        return cls(base, platform, alpha, float(params["l0"]) + float(params["l2"]), rho)
+        return cls(
+            base,
+            platform,
+            alpha,
+            float(params["l0"]) + float(params["l2"]),
+            rho,
+            float(params["l0"]),
+        )
 
 
 def wrap(angle: float) -> float:
@@ -520,11 +528,23 @@ def _add_mode(geom: Geometry, modes: list[Pose], q: Pose) -> None:
     modes.append(q)
 
 
+#: A pose whose reach is below this is refused (the generated code's MIN_REACH).
+MIN_REACH = 1e-9
+
+
+def reach(geom: Geometry, q: Sequence[float]) -> float:
+    """``min (l0 + lambda21) / l0`` over the legs: 1 central, <= 0 with a piston joint on or
+    behind its base pivot (a pose the generated code refuses)."""
+    d, _ = _legs(geom, q)
+    l2 = geom.offset - geom.l0
+    return min((math.hypot(*di) - l2) / geom.l0 for di in d)
+
+
 def assembly_modes(geom: Geometry, actuation: str, qa: Sequence[float], **kw) -> list[Pose]:
-    """Every assembly mode for ``qa`` (closed form or sextic): at most 2 or 6 poses."""
-    if actuation == "revolute":
-        return revolute_modes(geom, qa)
-    return prismatic_modes(geom, qa, **kw)
+    """Every assembly mode for ``qa`` (closed form or sextic): at most 2 or 6 poses, each one
+    the generated code evaluates (reach above :data:`MIN_REACH`)."""
+    modes = revolute_modes(geom, qa) if actuation == "revolute" else prismatic_modes(geom, qa, **kw)
+    return [m for m in modes if reach(geom, m) > MIN_REACH]
 
 
 # ----------------------------------------------------------------------------------------------
@@ -556,7 +576,8 @@ def tracked_forward_kinematics(
 
     1. :func:`closure_newton` from ``q_near`` (at most ``max_iter`` steps, largest residual
        ``<= tol``, step limited to ``rho`` in the pose metric, backtracking line search).
-    2. Accepted when it converged, every leg length is positive, and ``det J`` at the solution
+    2. Accepted when it converged, every leg length is positive, the pose is one the generated
+       code evaluates (:func:`reach` above :data:`MIN_REACH`), and ``det J`` at the solution
        has the sign it has at ``q_near`` (same aspect: Newton did not jump across a parallel
        singularity into another mode).
     3. Otherwise (fallback): every mode, by the closed form (revolute) or by sampling the sextic
@@ -582,14 +603,16 @@ def tracked_forward_kinematics(
             if actuation == "revolute"
             else min(math.hypot(*di) for di in d)
         ) > LENGTH_TOL * geom.rho
-        if positive and det_near * det_here > 0:
+        if positive and reach(geom, result.q) > MIN_REACH and det_near * det_here > 0:
             return Tracked(result.q, "newton", result.iterations)
     if not fallback:
         return Tracked((math.nan, math.nan, math.nan), "none", result.iterations)
-    if actuation == "revolute":
-        modes = revolute_modes(geom, qa)
-    else:
-        modes = prismatic_modes(geom, qa, method="sampling", samples=samples)
+    modes = assembly_modes(
+        geom,
+        actuation,
+        qa,
+        **({} if actuation == "revolute" else {"method": "sampling", "samples": samples}),
+    )
     best: Pose | None = None
     for m in modes:
         m = (m[0], m[1], unwrap_near(m[2], near[2]))
@@ -602,6 +625,11 @@ def tracked_forward_kinematics(
 
 # ----------------------------------------------------------------------------------------------
 # Samples shared by the forward-kinematics tests.
+
+
+def evaluable(geom: Geometry, poses: np.ndarray) -> np.ndarray:
+    """The rows of ``poses`` the generated code evaluates (:func:`reach` above MIN_REACH)."""
+    return np.array([p for p in poses if reach(geom, p) > MIN_REACH]).reshape(-1, 3)
 
 
 def random_poses(rng: np.random.Generator, n: int) -> np.ndarray:

@@ -1,4 +1,4 @@
-"""The control model's mathematics (derive/rpr3/control.py, tests/fk_reference.py), numerically.
+"""The control model's mathematics (derive/planar/control.py, tests/fk_reference.py), numerically.
 
 The symbolic expressions are evaluated assignment by assignment (``program_eval``) and checked
 against the independent Newton-Euler reference (``newton_euler``: inverse kinematics, joint loads,
@@ -17,10 +17,9 @@ import numpy as np
 import pytest
 import sympy as sp
 from rpr3gen_derive.codegen.program import Program
-from rpr3gen_derive.rpr3 import control, direct_kinematics, registry
-from rpr3gen_derive.rpr3 import symbols as syms
-from rpr3gen_derive.rpr3.derivation import derive
-from rpr3gen_derive.rpr3.symbols import PARAM_NAMES
+from rpr3gen_derive.planar import control, direct_kinematics, paper, registry, structures
+from rpr3gen_derive.planar import symbols as syms
+from rpr3gen_derive.planar.derivation import derive
 
 try:
     from . import newton_euler as ne
@@ -34,7 +33,10 @@ EFFORT = {"revolute": "m10", "prismatic": "f21z"}
 COORDINATE = {"revolute": "phi10", "prismatic": "lambda21"}
 RATE = {"revolute": "omega10", "prismatic": "v21"}
 ACCELERATION = {"revolute": "eps10", "prismatic": "gamma21"}
-PARAMS = [syms.params[name] for name in PARAM_NAMES]
+PARAM_NAMES = paper.PARAM_NAMES
+PARAMS = [paper.params[name] for name in PARAM_NAMES]
+#: The paper's two variants, by actuation.
+S = {a: structures.from_variant(a) for a in ACTUATIONS}
 T = np.linspace(0.0, 2.0, 41)
 SEEDS = (1, 2, 3)
 COS_IN, SIN_IN = sp.Symbol("cos_phi_in", real=True), sp.Symbol("sin_phi_in", real=True)
@@ -52,21 +54,23 @@ class Model:
 
 def _build(actuation: str) -> Model:
     prog = Program()
-    J = control.actuator_jacobian(prog, actuation)
-    rate = control.jacobian_rate_term(prog, actuation)
-    M, c = control.task_space_dynamics(prog, actuation)
-    qdd = control.forward_dynamics(prog, actuation)
+    J = control.actuator_jacobian(prog, S[actuation])
+    rate = control.jacobian_rate_term(prog, S[actuation])
+    M, c = control.task_space_dynamics(prog, S[actuation])
+    qdd = control.forward_dynamics(prog, S[actuation])
     outputs = [*J, *rate, *M, *c, *qdd]
-    inputs = [*PARAMS, *syms.q, *syms.qd, *control.tau]
+    inputs = [*PARAMS, *syms.q, *syms.qd, *syms.tau]
     dynamics = compile_program(prog, inputs, outputs)
+    robot = structures.robot(S[actuation])
+    holds = direct_kinematics.locked_legs(robot, S[actuation])
     if actuation == "revolute":
-        modes = direct_kinematics.assembly_modes_revolute(prog)
+        modes = direct_kinematics.line_modes(prog, robot, holds)
         fk_out = [getattr(m, name) for m in modes for name in ("x", "y", "phi", "margin")]
-        fk_fn = compile_program(prog, [*PARAMS, *control.qa], fk_out)
+        fk_fn = compile_program(prog, [*PARAMS, *syms.qa], fk_out)
     else:
-        coefficients = direct_kinematics.sextic_coefficients(prog)
-        x, y = direct_kinematics.pose_from_angle(prog, COS_IN, SIN_IN)
-        fk_fn = compile_program(prog, [*PARAMS, *control.qa, COS_IN, SIN_IN], [*coefficients, x, y])
+        coefficients = direct_kinematics.sextic_coefficients(prog, holds)
+        x, y = direct_kinematics.pose_from_angle(prog, holds, COS_IN, SIN_IN)
+        fk_fn = compile_program(prog, [*PARAMS, *syms.qa, COS_IN, SIN_IN], [*coefficients, x, y])
     return Model(actuation, prog, dynamics, fk_fn)
 
 
@@ -88,7 +92,7 @@ def _inputs(params: dict, q: np.ndarray, qd: np.ndarray, tau: np.ndarray | None 
     for k, name in enumerate(syms.VELOCITY_NAMES):
         values[name] = qd[:, k]
     tau = np.zeros_like(q) if tau is None else tau
-    for k, name in enumerate(control.TAU_NAMES):
+    for k, name in enumerate([t.name for t in syms.tau]):
         values[name] = tau[:, k]
     return values
 
@@ -136,25 +140,25 @@ def _wrap(a):
 
 
 def test_the_program_extends_the_inverse_dynamics_unchanged(model: Model) -> None:
-    reference, _ = derive(model.actuation)
+    reference = derive(S[model.actuation]).program
     prog = model.program
     n = len(reference.assignments)
     assert prog.assignments[:n] == reference.assignments
     # Calling the functions again, in another order, on the same program reuses what is there.
     size = len(prog.assignments)
-    control.forward_dynamics(prog, model.actuation)
-    control.task_space_dynamics(prog, model.actuation)
-    control.jacobian_rate_term(prog, model.actuation)
-    control.actuator_jacobian(prog, model.actuation)
+    control.forward_dynamics(prog, S[model.actuation])
+    control.task_space_dynamics(prog, S[model.actuation])
+    control.jacobian_rate_term(prog, S[model.actuation])
+    control.actuator_jacobian(prog, S[model.actuation])
     assert len(prog.assignments) == size
 
 
 def test_names_never_shadow_parameters_or_inputs() -> None:
     for actuation in ACTUATIONS:
-        for spec in registry.module(actuation).functions:
+        for spec in registry.module(S[actuation]).functions:
             names = [a.symbol.name for a in spec.program.assignments]
             assert len(names) == len(set(names))
-            assert not set(names) & set(control._RESERVED)
+            assert not set(names) & control.reserved(S[actuation])
 
 
 # ----------------------------------------------------------------------------------------------
@@ -220,7 +224,7 @@ def test_both_methods_and_both_actuations_give_one_mass_matrix() -> None:
     for actuation in ACTUATIONS:
         for method in ("virtual_power", "efforts"):
             prog = Program()
-            M, c = control.task_space_dynamics(prog, actuation, method=method)
+            M, c = control.task_space_dynamics(prog, S[actuation], method=method)
             f = compile_program(prog, [*PARAMS, *syms.q, *syms.qd], [*M, *c])
             results.append(np.array(f(**_inputs(params, q, qd))))
     for other in results[1:]:
@@ -279,7 +283,7 @@ def test_free_motion_conserves_energy(model: Model) -> None:
 
 def _qa_inputs(params: dict, qa: np.ndarray) -> dict:
     values: dict = dict(params)
-    for k, name in enumerate(control.QA_NAMES):
+    for k, name in enumerate([a.name for a in syms.qa]):
         values[name] = qa[..., k]
     return values
 
@@ -304,8 +308,15 @@ def test_revolute_modes_round_trip(models: dict[str, Model]) -> None:
         qa = _reference_qa(params, "revolute", poses)
         out = np.array(model.fk(**_qa_inputs(params, qa)))  # (8, n): x, y, phi, margin per mode
         for n, (pose, qa_n) in enumerate(zip(poses, qa, strict=True)):
+            # The candidates that exist (margin >= 0) and are modes: every leg in its working
+            # mode there, the leg ahead of its pivot along the actuated axis (as the runtime and
+            # the C check by the inverse kinematics).
             symbolic = [
-                tuple(out[4 * m : 4 * m + 3, n]) for m in range(2) if out[4 * m + 3, n] >= 0
+                tuple(out[4 * m : 4 * m + 3, n])
+                for m in range(2)
+                if out[4 * m + 3, n] >= 0
+                and min(fk.leg_lengths_along_axis(geom, qa_n, out[4 * m : 4 * m + 3, n]))
+                > 1e-9 * geom.rho
             ]
             numeric = fk.revolute_modes(geom, qa_n)
             counts.append(len(numeric))
@@ -330,8 +341,15 @@ def test_revolute_degenerate_inputs_have_no_mode(models: dict[str, Model]) -> No
     qa = np.stack([parallel, unreachable])
     out = np.array(model.fk(**_qa_inputs(params, qa)))
     with np.errstate(all="ignore"):
-        assert not (out[3] >= 0).any()  # margins: a mode exists where >= 0
-        assert not (out[7] >= 0).any()
+        # Parallel legs: no candidate at all (both margins negative).
+        assert not out[3, 0] >= 0
+        assert not out[7, 0] >= 0
+        # Unreachable: candidates exist, but each has a leg behind its pivot (another working
+        # mode), so neither is a mode.
+        for m in range(2):
+            candidate = out[4 * m : 4 * m + 3, 1]
+            lengths = fk.leg_lengths_along_axis(geom, qa[1], candidate)
+            assert not (out[4 * m + 3, 1] >= 0 and min(lengths) > 0)
     for q in qa:
         assert fk.revolute_modes(geom, q) == []
     # The paper's congruent triangles: every leg has zero length at G = 0, phi = -pi/3 for any
@@ -523,7 +541,7 @@ def test_tracking_converges_from_a_nearby_reference(actuation: str) -> None:
     rng = np.random.default_rng(21)
     for params in fk.robots(rng, 6):
         geom = fk.Geometry.from_params(params)
-        for pose in fk.random_poses(rng, 5):
+        for pose in fk.evaluable(geom, fk.random_poses(rng, 5)):
             if not ne.well_conditioned(params, pose[None, :], max_cond=1e3):
                 continue
             qa = _reference_qa(params, actuation, pose)[0]

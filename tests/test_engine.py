@@ -15,24 +15,26 @@ import pytest
 import sympy as sp
 from rpr3gen_derive.codegen import Check, Component, FunctionSpec, Output, Program
 from rpr3gen_derive.codegen.files import write_files
-from rpr3gen_derive.rpr3 import generate, registry
-from rpr3gen_derive.rpr3 import symbols as syms
+from rpr3gen_derive.planar import generate, paper, registry, structures
+from rpr3gen_derive.planar import symbols as syms
 
 import rpr3gen
 from rpr3gen import manifest
 from rpr3gen.evaluators import evaluator
 
 ACTUATIONS = ("revolute", "prismatic")
+#: The paper's two variants, by actuation.
+S = {a: structures.from_variant(a) for a in ACTUATIONS}
 
 
-def leg_lengths(actuation: str) -> FunctionSpec:
+def leg_lengths(structure: structures.Structure) -> FunctionSpec:
     """Toy spec: |A1 A3| of each leg at the pose q (eq. 5), and its smallest value."""
     prog = Program()
     cos_phi = prog.define("cos_phi", sp.cos(syms.phi), "pose")
     sin_phi = prog.define("sin_phi", sp.sin(syms.phi), "pose")
     lengths = []
     for leg in syms.LEGS:
-        p, a1 = syms.platform_joint(leg), syms.base_pivot(leg)
+        p, a1 = paper.platform_joint(leg), paper.base_pivot(leg)
         dx = syms.x + cos_phi * p[0] - sin_phi * p[1] - a1[0]
         dy = syms.y + sin_phi * p[0] + cos_phi * p[1] - a1[1]
         lengths.append(prog.define(f"L_{leg}", sp.sqrt(dx**2 + dy**2), "pose"))
@@ -56,7 +58,10 @@ def leg_lengths(actuation: str) -> FunctionSpec:
                 "below",
                 "SINGULAR",
                 threshold="MIN_REACH",
-                guard=("reach", (sp.Min(*lengths) - syms.l2) / syms.l0),
+                guard=(
+                    "reach",
+                    (sp.Min(*lengths) - paper.params["l2"]) / paper.params["l0"],
+                ),
             ),
         ),
     )
@@ -66,7 +71,7 @@ def leg_lengths(actuation: str) -> FunctionSpec:
 def toy_folder(tmp_path_factory: pytest.TempPathFactory) -> Path:
     functions = {**registry.FUNCTIONS, "leg_lengths": leg_lengths}
     out = tmp_path_factory.mktemp("generated")
-    write_files(out, generate.render(ACTUATIONS, functions=functions))
+    write_files(out, generate.render(tuple(S.values()), functions=functions))
     return out
 
 
@@ -95,7 +100,7 @@ def test_a_toy_spec_is_rendered_compiled_and_called_by_name(
     assert "leg_lengths" not in registry.FUNCTIONS  # the temporary registry only
     variant = manifest.load(actuation, toy_folder)
     assert set(variant.functions) == {*registry.FUNCTIONS, "leg_lengths"} - {
-        name for name in registry.FUNCTIONS if registry.FUNCTIONS[name](actuation) is None
+        name for name in registry.FUNCTIONS if registry.FUNCTIONS[name](S[actuation]) is None
     }
     header = variant.path("c_header").read_text()
     assert "int rpr3_leg_lengths(const double *params, const double q[3], double lengths[3]);" in (

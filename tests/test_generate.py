@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 from rpr3gen_derive.codegen import files
-from rpr3gen_derive.rpr3 import generate
+from rpr3gen_derive.planar import generate
 
 import rpr3gen
 from rpr3gen import manifest
@@ -113,10 +113,10 @@ def test_cse_reduces_the_operation_count(repo_root: Path) -> None:
 def test_source_hash_follows_the_sources(tmp_path: Path) -> None:
     copy = tmp_path / "derive"
     shutil.copytree(generate.ROBOT_DIR.parent, copy, ignore=shutil.ignore_patterns("__pycache__"))
-    roots = (copy / "codegen", copy / "rpr3")
+    roots = (copy / "codegen", copy / "planar")
     original = files.source_hash(roots)
     assert original == generate.source_hash()
-    frames = copy / "rpr3" / "frames.py"
+    frames = copy / "planar" / "legs.py"
     frames.write_text(frames.read_text() + "\n# edit\n")
     assert files.source_hash(roots) != original
 

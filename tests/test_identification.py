@@ -182,7 +182,7 @@ def test_rank_of_the_stacked_regressor_is_b(
 def test_base_matrix_is_the_closed_form_regrouping(robot: str | int, identical: bool) -> None:
     """The runtime's numerical base parameters equal the derivation's closed-form regroupings
     (docs/identification.md) for the model's geometry."""
-    from rpr3gen_derive.rpr3 import identification as derived
+    from rpr3gen_derive.planar import identification as derived
 
     model, *_ = _exciting("revolute", robot)
     base = rpr3gen.base_parameters(model, identical_legs=identical)

@@ -1,5 +1,5 @@
 """The mathematics of dynamic identification (issue 13): regressor, payload efforts, base
-parameters (derive/rpr3/identification.py, docs/identification.md).
+parameters (derive/planar/identification.py, docs/identification.md).
 
 The regressor ``Y`` (tau = Y pi + tau_payload) is checked against the independent Newton-Euler
 reference (tests/newton_euler.py) for the model's parameters, against it again with the
@@ -18,13 +18,17 @@ import pytest
 import sympy as sp
 from program_eval import compile_program, values_of
 from rpr3gen_derive.codegen.program import Program
-from rpr3gen_derive.rpr3 import identification as idn
-from rpr3gen_derive.rpr3 import symbols as syms
-from rpr3gen_derive.rpr3.control import ACTUATORS
+from rpr3gen_derive.planar import identification as idn
+from rpr3gen_derive.planar import paper, structures
+from rpr3gen_derive.planar import symbols as syms
 
 ACTUATIONS = ("revolute", "prismatic")
+#: The paper's two variants, by actuation.
+S = {a: structures.from_variant(a) for a in ACTUATIONS}
+EFFORT = {"revolute": "m10", "prismatic": "f21z"}
+RATE = {"revolute": "omega10", "prismatic": "v21"}
 P = len(idn.INERTIAL_PARAMETER_NAMES)
-INPUTS = [*syms.params.values(), *syms.q, *syms.qd, *syms.qdd]
+INPUTS = [*paper.params.values(), *syms.q, *syms.qd, *syms.qdd]
 PI = [idn.pi_symbols[n] for n in idn.INERTIAL_PARAMETER_NAMES]
 T = np.linspace(0.0, 4.0, 41)
 
@@ -41,9 +45,9 @@ LITERATURE_10 = (
 def _functions(actuation: str):
     """(Y and tau_payload, efforts with symbolic pi), compiled from one program."""
     prog = Program()
-    Y = idn.regressor(prog, actuation)
-    payload = idn.payload_efforts(prog, actuation)
-    efforts = idn.efforts(prog, actuation)
+    Y = idn.regressor(prog, S[actuation])
+    payload = idn.payload_efforts(prog, S[actuation])
+    efforts = idn.efforts(prog, S[actuation])
     regression = compile_program(prog, INPUTS, [*Y, *payload])
     symbolic = compile_program(prog, INPUTS + PI, efforts)
     return regression, symbolic
@@ -63,7 +67,7 @@ def regression(actuation: str, params, q, qd, qdd) -> tuple[np.ndarray, np.ndarr
 
 def reference_efforts(params, actuation: str, q, qd, qdd) -> np.ndarray:
     out = ne.solve(params, actuation, q, qd, qdd)
-    effort = ACTUATORS[actuation].effort
+    effort = EFFORT[actuation]
     return np.stack([out[f"{effort}_{leg}"] for leg in ne.LEGS], axis=-1)
 
 
@@ -218,7 +222,7 @@ def test_every_column_satisfies_the_power_balance(actuation: str) -> None:
     """``sum_legs Y[leg, j] qa'_leg = dE_j/dt`` for each of the 28 columns separately (the
     first moments normal to the legs, mcy_1*, mcy_2*, which the model's pi leaves at zero,
     included); and the payload efforts do the payload's work."""
-    rate = ACTUATORS[actuation].rate
+    rate = RATE[actuation]
     for _label, params, q, qd, qdd in _cases():
         Y, payload = regression(actuation, params, q, qd, qdd)
         kin = ne.kinematics(params, q, qd, qdd)
@@ -254,15 +258,16 @@ def test_efforts_are_linear_in_pi(actuation: str) -> None:
 def test_regressor_shares_a_program_with_the_inverse_dynamics() -> None:
     """Appended to a program that already holds the model's derivation, the kinematics are
     shared and the differently defined loads renamed; the values do not change."""
-    from rpr3gen_derive.rpr3.derivation import derive
+    from rpr3gen_derive.planar.derivation import derive
 
-    prog, outputs = derive("revolute")
+    derivation = derive(S["revolute"])
+    prog, outputs = derivation.program, derivation.outputs
     before = len(prog.assignments)
-    Y = idn.regressor(prog, "revolute")
+    Y = idn.regressor(prog, S["revolute"])
     assert len(prog.assignments) > before
     names = [a.symbol.name for a in prog.assignments]
     assert len(names) == len(set(names))
-    assert "m10_A__pi" in names
+    assert "load1r_A__pi" in names  # the motor torque of leg A, with pi symbolic
     _label, params, q, qd, qdd = next(iter(_cases()))
     f = compile_program(prog, INPUTS, [*Y, outputs["m10_A"]])
     out = f(**values_of(params, **_motion(q, qd, qdd)))
@@ -324,7 +329,7 @@ def test_base_parameters(actuation: str, robot: str, identical_legs: bool, B: in
 def test_regroupings_in_closed_form() -> None:
     r = idn.regroupings(identical_legs=True)
     s = {n: sp.Symbol(n, real=True) for n in idn.SHARED_PARAMETER_NAMES}
-    l2 = syms.l2
+    l2 = paper.params["l2"]
     assert sp.expand(r["Jzz_1"] - (s["Jzz_1"] + s["Jzz_2"] - l2**2 * s["m_2"])) == 0
     assert sp.expand(r["mcx_2"] - (s["mcx_2"] - l2 * s["m_2"])) == 0
     assert sp.expand(r["m_3"] - (s["m_3"] + 3 * s["m_2"])) == 0

@@ -8,31 +8,34 @@
   printer, lowering and templates;
 - :mod:`.render`: the :class:`Generator` that drives them and writes the manifest;
 - :mod:`.files`: source hash, atomic writes and the regeneration check.
+
+The names below are imported on first use, so that :mod:`.files` (standard library only) can be
+imported without SymPy: the runtime hashes the generator's sources with it.
 """
 
-from rpr3gen_derive.codegen.program import Assignment, Program
-from rpr3gen_derive.codegen.render import Generator
-from rpr3gen_derive.codegen.spec import (
-    Argument,
-    Check,
-    Component,
-    FunctionSpec,
-    ModuleSpec,
-    Output,
-    ReturnCode,
-    Threshold,
-)
+from __future__ import annotations
 
-__all__ = [
-    "Argument",
-    "Assignment",
-    "Check",
-    "Component",
-    "FunctionSpec",
-    "Generator",
-    "ModuleSpec",
-    "Output",
-    "Program",
-    "ReturnCode",
-    "Threshold",
-]
+import importlib
+from typing import Any
+
+_EXPORTS = {
+    "Assignment": "program",
+    "Program": "program",
+    "Generator": "render",
+    "Argument": "spec",
+    "Check": "spec",
+    "Component": "spec",
+    "FunctionSpec": "spec",
+    "ModuleSpec": "spec",
+    "Output": "spec",
+    "ReturnCode": "spec",
+    "Threshold": "spec",
+}
+
+__all__ = sorted(_EXPORTS)
+
+
+def __getattr__(name: str) -> Any:
+    if name not in _EXPORTS:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    return getattr(importlib.import_module(f"{__name__}.{_EXPORTS[name]}"), name)

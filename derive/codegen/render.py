@@ -122,6 +122,7 @@ def manifest(module: ModuleSpec, digest: str, files: dict[str, str]) -> str:
             {"name": t.name, "value": t.value, "meaning": t.meaning} for t in module.thresholds
         ],
         "tables": {f"{prefix}_{t.table}": _components(t) for t in module.tables},
+        "defines": {name: literal for name, literal, _ in module.defines},
         "functions": [
             {
                 "name": f.name,

@@ -221,5 +221,3 @@ def cofactor_solve(prog: Program, A: sp.Matrix, rhs: sp.Matrix, name: str, step:
             for i in range(3)
         ]
     )
-
-

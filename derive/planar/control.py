@@ -18,6 +18,7 @@ See ``docs/control-model.md`` for the mathematics and the operation counts.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from functools import cache
 
 import sympy as sp
@@ -147,6 +148,11 @@ def _effort_affine(prog: Program, structure: Structure) -> tuple[sp.Matrix, sp.M
     return A, b
 
 
+def _reusing(bld: Builder) -> Callable[[str, sp.Expr, str], sp.Expr]:
+    """``define`` that reuses an assignment of the same name and right-hand side."""
+    return lambda name, expr, step: bld.define(name, expr, step, share=False)
+
+
 def _own_joint_powers(prog: Program, derivation: Derivation) -> dict[str, list[sp.Expr]]:
     """Per leg, the power per unit rate of each joint's own motion of the chain wrench of the
     leg's own two bodies (without the platform): ``M_j`` of a revolute joint, ``F_j . w_j`` of
@@ -157,7 +163,9 @@ def _own_joint_powers(prog: Program, derivation: Derivation) -> dict[str, list[s
         kin = derivation.kinematics[leg]
         wrenches = derivation.wrenches[leg]
         if leg == LEGS[0]:
-            wrenches = leg_wrenches(prog, kin, None, derivation.robot, tag="own")
+            wrenches = leg_wrenches(
+                prog, kin, None, derivation.robot, tag="own", define=_reusing(Builder(prog))
+            )
         powers = []
         for j in (1, 2, 3):
             w = wrenches.joints[j - 1]

@@ -7,12 +7,14 @@ eqs. 5, 6 and 9, the required wrenches and their recursion, eqs. 10-11, the virt
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import sympy as sp
 from rpr3gen_derive.codegen.program import Program
 from rpr3gen_derive.planar import structures
 from rpr3gen_derive.planar.dynamics import (
+    Inertia,
     InertiaBuilder,
     LegWrenches,
     leg_inertias,
@@ -50,15 +52,16 @@ def algorithm(
     actuated: int,
     inertias: InertiaBuilder = leg_inertias,
     tag: str = "",
+    platform_body: Callable[[Robot, sp.Expr, sp.Expr], Inertia] = platform_inertia,
 ) -> tuple[dict[str, LegKinematics], dict[str, LegWrenches], Loads]:
     """The paper's algorithm on ``prog``: the leg kinematics (eqs. 5, 6, 9), each leg's wrenches
     (eqs. 10-11; leg A carries the platform) and every joint load by virtual work (eqs. 7-8,
-    12-17). ``inertias`` gives the legs' bodies' inertial data (the regressor passes symbols);
-    ``tag`` marks the names of the wrenches and loads that depend on it."""
+    12-17). ``inertias`` and ``platform_body`` give the bodies' inertial data (the regressor
+    passes symbols); ``tag`` marks the names of the wrenches and loads that depend on them."""
     robot = named_constants(prog, robot)
     platform = platform_rotation(prog)
     kinematics = {leg: leg_kinematics(prog, robot, leg, platform) for leg in LEGS}
-    carried = platform_wrench(robot, platform_inertia(robot, platform.cos_phi, platform.sin_phi))
+    carried = platform_wrench(robot, platform_body(robot, platform.cos_phi, platform.sin_phi))
     wrenches = {
         leg: leg_wrenches(
             prog, kinematics[leg], carried if leg == LEGS[0] else None, robot, inertias, tag
@@ -66,7 +69,7 @@ def algorithm(
         for leg in LEGS
     }
     rho2 = platform_radius2([robot.legs[leg].platform_point for leg in LEGS])
-    return kinematics, wrenches, joint_loads(prog, actuated, kinematics, wrenches, rho2)
+    return kinematics, wrenches, joint_loads(prog, actuated, kinematics, wrenches, rho2, tag)
 
 
 def derive(structure: Structure) -> Derivation:

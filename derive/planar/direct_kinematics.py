@@ -111,8 +111,8 @@ class Locked:
     kind: str
     a: Vec
     b: Vec
-    n: Vec = (sp.Integer(0), sp.Integer(0))
-    r2: sp.Expr = sp.Integer(0)
+    n: Vec = (sp.S.Zero, sp.S.Zero)
+    r2: sp.Expr = sp.S.Zero
 
 
 def locked_kind(kinds: str, actuated: int) -> str:
@@ -127,7 +127,9 @@ def _simple(expr: sp.Expr) -> sp.Expr:
     return sp.trigsimp(sp.expand(expr))
 
 
-def locked_leg(g: LegGeometry, actuated: int, qa: sp.Expr, cos_qa: sp.Expr, sin_qa: sp.Expr) -> Locked:
+def locked_leg(
+    g: LegGeometry, actuated: int, qa: sp.Expr, cos_qa: sp.Expr, sin_qa: sp.Expr
+) -> Locked:
     """Leg ``g``'s hold on the platform with joint ``actuated`` locked at ``qa``."""
     offset = sub(g.points[2], g.platform_point)  # g0: the pose at zero joint coordinates
     g0_inverse = Rigid(sp.Integer(1), sp.Integer(0), scale(-1, offset))
@@ -154,11 +156,17 @@ def locked_leg(g: LegGeometry, actuated: int, qa: sp.Expr, cos_qa: sp.Expr, sin_
         return (_simple(v[0]), _simple(v[1]))
 
     if kind == "circle":  # |N(cj) - ci| = |cj - ci|
-        return Locked(kind, vec(right(j.point)), vec(back(i.point)), r2=_simple(norm2(sub(j.point, i.point))))
+        return Locked(
+            kind, vec(right(j.point)), vec(back(i.point)), r2=_simple(norm2(sub(j.point, i.point)))
+        )
     if kind == "line":  # N(cj) - cj along u_i
-        return Locked(kind, vec(right(j.point)), vec(back(j.point)), n=vec(perp(back.turn(i.point))))
+        return Locked(
+            kind, vec(right(j.point)), vec(back(j.point)), n=vec(perp(back.turn(i.point)))
+        )
     if kind == "platform_line":  # N^-1(ci) - ci along u_j
-        return Locked(kind, vec(right(i.point)), vec(back(i.point)), n=vec(perp(right.turn(j.point))))
+        return Locked(
+            kind, vec(right(i.point)), vec(back(i.point)), n=vec(perp(right.turn(j.point)))
+        )
     raise ValueError(f"{g.kinds} locked at joint {actuated} holds only the platform's angle")
 
 
@@ -235,7 +243,7 @@ def line_modes(prog: Program, robot: Robot, holds: dict[str, Locked]) -> list[Mo
     s_xy = sum(n[leg][0] * n[leg][1] for leg in LEGS)
     ksq = bld.define("fk_ksq", sum(k[leg] ** 2 for leg in LEGS), step)
     inv_ksq = bld.define("fk_inv_ksq", 1 / ksq, step)
-    rho2 = platform_rms_radius(robot) ** 2
+    rho2 = bld.define("fk_rho2", platform_rms_radius(robot) ** 2, step)
     modes = []
     for m, sign in ((1, 1), (2, -1)):
         cos_a = bld.define(f"fk{m}_cos", (-A * C - sign * B * root) * inv_ab2, step)

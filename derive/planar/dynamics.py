@@ -117,29 +117,33 @@ def leg_wrenches(
     robot: Robot,
     inertias: InertiaBuilder = leg_inertias,
     tag: str = "",
+    define: Callable[[str, sp.Expr, str], sp.Expr] | None = None,
 ) -> LegWrenches:
     """``(F_k, M_k)`` of eqs. (10)-(11) for one leg, in its frame, named ``W1_A_x`` and so on.
 
     ``platform``: the platform's required wrench about G (world) when this leg carries it, else
     None.
     ``inertias``: the bodies' inertial data (the model's numbers, or symbols for the regressor).
+    ``define``: how to name an assignment (default ``prog.define``; a builder's reuses one that
+    exists with the same right-hand side).
     """
     leg = kin.leg
+    define = define or prog.define
 
     def named(name: str, w: Wrench, step: str) -> Wrench:
         return Wrench(
             (
-                prog.define(f"{name}{tag}_{leg}_x", w.force[0], step),
-                prog.define(f"{name}{tag}_{leg}_y", w.force[1], step),
+                define(f"{name}{tag}_{leg}_x", w.force[0], step),
+                define(f"{name}{tag}_{leg}_y", w.force[1], step),
             ),
-            prog.define(f"{name}{tag}_{leg}_z", w.moment, step),
+            define(f"{name}{tag}_{leg}_z", w.moment, step),
         )
 
     body1, body2 = inertias(kin)
     gravity = kin.to_frame(robot.gravity)
     g = (
-        prog.define(f"g{tag}_{leg}_x1", gravity[0], STEP_INERTIA),
-        prog.define(f"g{tag}_{leg}_y1", gravity[1], STEP_INERTIA),
+        define(f"g{tag}_{leg}_x1", gravity[0], STEP_INERTIA),
+        define(f"g{tag}_{leg}_y1", gravity[1], STEP_INERTIA),
     )
     own1 = required_wrench(body1, kin.accel[0], kin.omega[0], kin.eps[0], g)
     own2 = required_wrench(body2, kin.accel[1], kin.omega[1], kin.eps[1], g)

@@ -155,7 +155,7 @@ def named_constants(prog: Program, robot: Robot) -> Robot:
 
     legs = {}
     for leg, g in robot.legs.items():
-        refs = tuple(
+        refs: tuple[Reference, ...] = tuple(
             ref
             if ref.unit
             else dataclasses.replace(ref, squared_length=name(leg, f"h{k + 1}sq", norm2(ref.home)))
@@ -163,7 +163,7 @@ def named_constants(prog: Program, robot: Robot) -> Robot:
         )
         legs[leg] = dataclasses.replace(
             g,
-            references=refs,
+            references=(refs[0], refs[1]),
             links=(pair(leg, "l12", g.links[0]), pair(leg, "l23", g.links[1])),
             com=(pair(leg, "c1", g.com[0]), pair(leg, "c2", g.com[1])),
             serial_home=None if g.serial_home is None else name(leg, "D0", g.serial_home),

@@ -39,8 +39,9 @@ Column = tuple[sp.Expr, sp.Expr, sp.Expr]
 class LegKinematics:
     """A leg's kinematic state, as program symbols; vectors in the leg frame (``pose.frame``).
 
-    ``s``: ``X3 - G`` (world frame); ``omega``, ``eps``: angular velocity and acceleration of bodies 1 and 2;
-    ``accel``: the accelerations of the joint points X1 (a point of body 1) and X2 (of body 2).
+    ``s``: ``X3 - G`` (world frame); ``omega``, ``eps``: angular velocity and acceleration of
+    bodies 1 and 2; ``accel``: the accelerations of the joint points X1 (a point of body 1) and
+    X2 (of body 2).
     """
 
     leg: str
@@ -179,7 +180,9 @@ def leg_kinematics(prog: Program, robot: Robot, leg: str, platform: Platform) ->
     omega = _rotations(g.kinds, qd)
 
     step = STEP_ACCELERATION
-    a3 = in_frame(e, add((syms.ddx, syms.ddy), scale(syms.ddphi, perp(s)), scale(-(syms.dphi**2), s)))
+    a3 = in_frame(
+        e, add((syms.ddx, syms.ddy), scale(syms.ddphi, perp(s)), scale(-(syms.dphi**2), s))
+    )
     zero = (sp.Integer(0),) * 3
     bias = _point_accelerations(g.kinds, pose, qd, zero, omega, (0, 0))[2]
     rhs = sub(a3, bias)
@@ -197,23 +200,6 @@ def leg_kinematics(prog: Program, robot: Robot, leg: str, platform: Platform) ->
         for k, a in enumerate((a1, a2))
     )
     return LegKinematics(leg, g, pose, s, qd, qdd, omega, eps, accel)  # type: ignore[arg-type]
-
-
-def serial_measure(prog: Program, kinematics: dict[str, LegKinematics]) -> sp.Expr:
-    """``min_i D_i / D_i(home)``: 1 at home, 0 at a serial singularity of a leg (dimensionless).
-
-    The working mode keeps ``D`` of the sign it has at home, so the ratio is positive wherever
-    the inverse kinematics has a solution; it falls to 0 where a leg's joint columns become
-    dependent (two links aligned, a slide through its pivot, ...), where the joint rates grow
-    without bound.
-    """
-    ratios = []
-    for leg, kin in kinematics.items():
-        home = kin.geometry.serial_home
-        if home is None:
-            raise ValueError(f"leg {leg}: no serial determinant at home to measure against")
-        ratios.append(kin.pose.D / home)
-    return prog.define("reach", sp.Min(*ratios), STEP_POSE)
 
 
 def body_offsets(kin: LegKinematics) -> tuple[Vec, Vec]:

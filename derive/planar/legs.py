@@ -253,18 +253,17 @@ def _rpp(leg: _Leg, platform: Platform, x3: Vec) -> LegPose:
     """RPP: both slides turn with the platform; the leg frame is the first, w2:
     ``y = q2 w2 + q3 w3``."""
     g = leg.g
-    (a12, b12), (a23, b23) = g.links
+    link1, link2 = g.links  # body 1's along u2, body 2's along u3
     w2 = leg.vector("w2", platform.turn(g.axis(2)))
     u3 = leg.vector("u3f", in_frame(g.axis(2), g.axis(3)))  # w3 in the frame: a constant
-    y = in_frame(w2, sub(x3, g.points[0]))
-    y = (y[0] - a12 - a23, y[1] - b12 - b23)
+    arm1 = in_frame(w2, sub(x3, g.points[0]))
+    y = sub(sub(arm1, link1), along(link2, u3))
     inv_d = leg.define("inv_det", 1 / u3[1])
     q3 = leg.coordinate(3, y[1] * inv_d)
     q2 = leg.coordinate(2, y[0] - q3 * u3[0])
     q1 = leg.coordinate(1, platform.phi)
-    arm2 = (a23 + q3 * u3[0], b23 + q3 * u3[1])
-    arm1 = (a12 + a23 + y[0], b12 + b23 + y[1])
-    return LegPose((q1, q2, q3), w2, (arm1, arm2), {2: X0, 3: u3}, (X0, X0), u3[1], (u3,))
+    arm2 = along((link2[0] + q3, link2[1]), u3)
+    return LegPose((q1, q2, q3), w2, (arm1, arm2), {2: X0, 3: u3}, (X0, u3), u3[1], (u3,))
 
 
 InverseKinematics = Callable[[_Leg, Platform, Vec], LegPose]

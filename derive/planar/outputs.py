@@ -20,7 +20,7 @@ import sympy as sp
 from rpr3gen_derive.codegen.program import Program
 from rpr3gen_derive.planar import paper
 from rpr3gen_derive.planar.geometry import LEGS, Robot
-from rpr3gen_derive.planar.kinematics import STEP_POSE, LegKinematics, serial_measure
+from rpr3gen_derive.planar.kinematics import STEP_POSE, LegKinematics
 from rpr3gen_derive.planar.structures import Structure
 from rpr3gen_derive.planar.virtual_work import Loads
 
@@ -96,9 +96,7 @@ def general_families(structure: Structure) -> tuple[OutputFamily, ...]:
                 "rate": f"d(q{j})/dt",
                 "acc": f"d2(q{j})/dt2",
             }[what]
-            out.append(
-                OutputFamily(f"q{suffix}{j}", _coordinate_unit(kinds[j - 1], per), meaning)
-            )
+            out.append(OutputFamily(f"q{suffix}{j}", _coordinate_unit(kinds[j - 1], per), meaning))
     for j in (1, 2, 3):
         by = f"of {_BODY[j]} on {_LATER[j]} through joint {j}"
         out.append(OutputFamily(f"fx{j}", "N", f"force {by}, world x0"))
@@ -187,6 +185,21 @@ def _general_values(
     return values
 
 
+def leg_reaches(structure: Structure, kinematics: dict[str, LegKinematics]) -> list[sp.Expr]:
+    """Each leg's serial measure, whose minimum is ``reach``: ``(l0 + lambda21) / l0`` for the
+    paper's legs, ``D / D(home)`` for the general format's."""
+    if structure.paper:
+        l0 = paper.params["l0"]
+        return [(l0 + kin.q[1]) / l0 for kin in kinematics.values()]
+    out = []
+    for leg, kin in kinematics.items():
+        home = kin.geometry.serial_home
+        if home is None:
+            raise ValueError(f"leg {leg}: no serial determinant at home to measure against")
+        out.append(kin.pose.D / home)
+    return out
+
+
 def inverse_dynamics_outputs(
     prog: Program,
     structure: Structure,
@@ -210,10 +223,5 @@ def inverse_dynamics_outputs(
         for name, expr in own.items():
             values[f"{name}_{leg}"] = expr
     values["conditioning"] = loads.conditioning
-    if structure.paper:
-        l0 = paper.params["l0"]
-        ratios = [(l0 + kin.q[1]) / l0 for kin in kinematics.values()]
-        values["reach"] = prog.define("reach", sp.Min(*ratios), STEP_POSE)
-    else:
-        values["reach"] = serial_measure(prog, kinematics)
+    values["reach"] = prog.define("reach", sp.Min(*leg_reaches(structure, kinematics)), STEP_POSE)
     return {name: values[name] for name in output_names(structure)}

@@ -1,4 +1,4 @@
-"""The paper's 3-RPR in its own parameters: the paper's derivation as one instance of the planar one.
+"""The paper's 3-RPR in its own parameters: the paper's derivation as one planar instance.
 
 The parameter vector is the paper's (docs/interfaces.md, "Generated C"): base pivots
 ``xA1..yC1`` (world), platform joints ``xA3..yC3`` (platform frame), leg angles
@@ -51,6 +51,37 @@ params: dict[str, sp.Symbol] = {
 NAMES = JointNames(
     ("phi10", "lambda21", "phi32"), ("omega10", "v21", "omega32"), ("eps10", "gamma21", "eps32")
 )
+
+
+def param_doc(name: str) -> tuple[str, str]:
+    """Unit and meaning of a model parameter (docs/interfaces.md)."""
+    fixed = {
+        "l0": ("m", "|A1A2| = l0 + lambda21"),
+        "l2": ("m", "|A2A3|"),
+        "c1": ("m", "cylinder centre of mass at A1 + c1 e"),
+        "c2": ("m", "piston centre of mass at A2 + c2 e"),
+        "c1_perp": ("m", "cylinder centre of mass off the leg axis: A1 + c1 e + c1_perp n"),
+        "c2_perp": ("m", "piston centre of mass off the leg axis: A2 + c2 e + c2_perp n"),
+        "m1": ("kg", "cylinder mass"),
+        "m2": ("kg", "piston mass"),
+        "m3": ("kg", "platform mass"),
+        "J1": ("kg m^2", "cylinder inertia about its centre of mass, axis z"),
+        "J2": ("kg m^2", "piston inertia about its centre of mass, axis z"),
+        "J3": ("kg m^2", "platform inertia about G, axis z"),
+        "gx": ("m/s^2", "gravity, world x0"),
+        "gy": ("m/s^2", "gravity, world y0 (up)"),
+        "fx": ("N", "payload force on the platform at G, x0"),
+        "fy": ("N", "payload force on the platform at G, y0"),
+        "mz": ("N m", "payload moment on the platform, about z0"),
+    }
+    if name in fixed:
+        return fixed[name]
+    if name.startswith("alpha_"):
+        return "rad", f"leg {name[-1]} angle where phi10 = 0"
+    axis, leg, point = name[0], name[1], name[2]
+    if point == "1":
+        return "m", f"base pivot {leg}1, world {axis}0"
+    return "m", f"platform joint {leg}3, platform frame {axis}G"
 
 
 def base_pivot(leg: str) -> tuple[sp.Symbol, sp.Symbol]:

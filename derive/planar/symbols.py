@@ -29,6 +29,4 @@ qa_dot = sp.Matrix([sp.Symbol(f"qa_dot_{leg}", real=True) for leg in LEGS])
 tau = sp.Matrix([sp.Symbol(f"tau_{leg}", real=True) for leg in LEGS])
 
 #: Names of every input symbol: no assignment may take one.
-INPUT_NAMES: frozenset[str] = frozenset(
-    s.name for s in (*q, *qd, *qdd, *qa, *qa_dot, *tau)
-)
+INPUT_NAMES: frozenset[str] = frozenset(s.name for s in (*q, *qd, *qdd, *qa, *qa_dot, *tau))

@@ -143,6 +143,7 @@ def joint_loads(
     kinematics: dict[str, LegKinematics],
     wrenches: dict[str, LegWrenches],
     platform_radius2: sp.Expr,
+    tag: str = "",
 ) -> Loads:
     """Every joint load of every leg by virtual work (eqs. 7-8 and 12-17).
 
@@ -160,7 +161,9 @@ def joint_loads(
     joint forces in its own leg.
 
     ``platform_radius2``: the squared RMS radius of the platform joints, the length that makes
-    rotation commensurable with translation in :func:`conditioning`.
+    rotation commensurable with translation in :func:`conditioning`. ``tag`` marks the names of
+    what depends on the wrenches (the powers, brackets and loads), so that a second run of the
+    algorithm on other wrenches (the regressor's) can share one program with the first.
     """
     legs = tuple(kinematics)
     motions = {leg: leg_motions(kinematics[leg], wrenches[leg]) for leg in legs}
@@ -177,7 +180,9 @@ def joint_loads(
         )
         null[leg] = n
         row = platform_twist_row(n, kinematics[leg].s, kinematics[leg].pose.frame)
-        rows.append([prog.define(f"W_{leg}{k + 1}", sp.expand(row[k]), STEP_CLOSURE) for k in range(3)])
+        rows.append(
+            [prog.define(f"W_{leg}{k + 1}", sp.expand(row[k]), STEP_CLOSURE) for k in range(3)]
+        )
     W = sp.Matrix(rows)
     det = prog.define("det_W", W.det(method="bareiss"), STEP_CLOSURE)
     inv_det = prog.define("inv_det_W", 1 / det, STEP_CLOSURE)
@@ -188,7 +193,7 @@ def joint_loads(
         lambda i, j: prog.define(f"Winv_{i + 1}{j + 1}", adjugate[i, j] * inv_det, STEP_CLOSURE),
     )
     power = {
-        (leg, m.name): prog.define(f"P{m.name}_{leg}", m.power, STEP_CLOSURE)
+        (leg, m.name): prog.define(f"P{m.name}{tag}_{leg}", m.power, STEP_CLOSURE)
         for leg in legs
         for m in motions[leg]
     }
@@ -201,10 +206,14 @@ def joint_loads(
         units = kinematics[leg].pose.units
         c1, c2 = (by_name[leg][f].column for f in free[leg])
         pairs = []
-        for k, (other, own) in enumerate(((c2, c1), (c1, c2))):
-            d = tuple(reduce_units(e, units) for e in _cross3(other, null[leg]))
-            den = reduce_units(_dot3(d, own), units)
-            scale_ = 1 / den if den.is_number else prog.define(f"inv_den{k + 1}_{leg}", 1 / den, STEP_CLOSURE)
+        for k, (across, along_) in enumerate(((c2, c1), (c1, c2))):
+            d = tuple(reduce_units(e, units) for e in _cross3(across, null[leg]))
+            den = reduce_units(_dot3(d, along_), units)
+            scale_ = (
+                1 / den
+                if den.is_number
+                else prog.define(f"inv_den{k + 1}_{leg}", 1 / den, STEP_CLOSURE)
+            )
             pairs.append((d, scale_))
         solvers[leg] = pairs
 
@@ -228,10 +237,10 @@ def joint_loads(
         total = sp.Integer(0)
         for other in legs:
             values = free_velocities(other, twist_at(other, unit_twist))
-            for f, value in zip(free[other], values, strict=True):
-                v = prog.define(f"v{f}_{leg}__{other}", value, STEP_VIRTUAL)
+            for f, velocity in zip(free[other], values, strict=True):
+                v = prog.define(f"v{f}{tag}_{leg}__{other}", velocity, STEP_VIRTUAL)
                 total = total + v * power[(other, f)]
-        bracket[leg] = prog.define(f"Q_{leg}", total, STEP_VIRTUAL)
+        bracket[leg] = prog.define(f"Q{tag}_{leg}", total, STEP_VIRTUAL)
 
     loads: dict[tuple[str, int], JointLoad] = {}
     for leg in legs:
@@ -245,9 +254,9 @@ def joint_loads(
             b = reduce_units(_dot3(null[leg], motion.column), kin.pose.units)
             own = free_velocities(leg, tuple(-c for c in motion.column))
             total = power[(leg, motion.name)] + b * bracket[leg]
-            for f, v in zip(free[leg], own, strict=True):
-                total = total + v * power[(leg, f)]
-            value[motion.name] = prog.define(f"load{motion.name}_{leg}", total, STEP_LOADS)
+            for f, velocity in zip(free[leg], own, strict=True):
+                total = total + velocity * power[(leg, f)]
+            value[motion.name] = prog.define(f"load{motion.name}{tag}_{leg}", total, STEP_LOADS)
         for j in (1, 2, 3):
             loads[(leg, j)] = JointLoad(
                 (value[f"{j}a"], value[f"{j}b"]), value[f"{j}r"], _world_basis(kin, j)

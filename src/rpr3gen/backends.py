@@ -16,18 +16,18 @@ from collections.abc import Iterator, Sequence
 import numpy as np
 from numpy.typing import ArrayLike
 
-from rpr3gen import manifest, policy
+from rpr3gen import manifest, policy, variants
 from rpr3gen.errors import InputError
 from rpr3gen.evaluators import BACKENDS, NumpyEvaluator, evaluator, thread_count
 from rpr3gen.model import Model
 
-__all__ = ["BACKENDS", "OUTPUT_NAMES", "evaluate", "inverse_dynamics"]
+__all__ = ["BACKENDS", "OUTPUT_NAMES", "evaluate", "inverse_dynamics", "output_names"]
 
 #: Output names of the inverse dynamics, family-major (``phi10_A, phi10_B, phi10_C,
 #: lambda21_A, ...``) as docs/conventions.md, then ``conditioning``: closeness to a parallel
 #: singularity, 0 (singular) to 1.
 OUTPUT_NAMES: tuple[str, ...] = (
-    manifest.load(manifest.available()[0]).function("inverse_dynamics").outputs[0].names
+    manifest.load("revolute").function("inverse_dynamics").outputs[0].names
 )
 #: Samples per call of the generated NumPy code: the temporaries of one block stay in cache
 #: and memory stays bounded however long the trajectory (benchmarks/ measures this). The C
@@ -108,7 +108,7 @@ def evaluate(
         The outputs of the function's interface, each seen as (n, size), and the (n,) return
         codes (0: ok). The outputs of a failed sample are NaN, whatever the backend.
     """
-    variant = manifest.load(model.actuation, model.generated)
+    variant = variants.load(model.structure, model.generated)
     info = variant.function(function)
     if len(inputs) != len(info.inputs):
         raise InputError(f"{function} takes {len(info.inputs)} inputs, got {len(inputs)}")
@@ -130,6 +130,13 @@ def evaluate(
             codes[block] = policy.apply(info, ins, outs, applied=ev.applies_checks)
     public = [o for o, arg in zip(outputs, info.outputs, strict=True) if not arg.hidden]
     return public, codes
+
+
+def output_names(model: Model) -> tuple[str, ...]:
+    """The inverse dynamics' output names of a model's variant, in order (the paper's
+    :data:`OUTPUT_NAMES`, or the general format's ``q1_A ... tau_C, conditioning, reach``)."""
+    info = variants.load(model.structure, model.generated).function("inverse_dynamics")
+    return info.outputs[0].names
 
 
 def inverse_dynamics(
@@ -162,5 +169,5 @@ def inverse_dynamics(
         arrays are views of one block (strided with ``"c"``).
     """
     (out,), _ = evaluate(model, "inverse_dynamics", (q, qd, qdd), backend, progress, threads)
-    names = manifest.load(model.actuation, model.generated).function("inverse_dynamics")
+    names = variants.load(model.structure, model.generated).function("inverse_dynamics")
     return dict(zip(names.outputs[0].names, out.T, strict=True))

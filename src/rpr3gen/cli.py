@@ -22,8 +22,8 @@ from typing import NoReturn, TextIO
 
 import numpy as np
 
-from rpr3gen import __version__, cli_identification, manifest
-from rpr3gen.backends import BACKENDS, OUTPUT_NAMES, inverse_dynamics
+from rpr3gen import __version__, cli_identification, variants
+from rpr3gen.backends import BACKENDS, inverse_dynamics, output_names
 from rpr3gen.design.maps import DEFAULT_RESOLUTION, WorkspaceMap
 from rpr3gen.design.sweeps import (
     DEFAULT_AREA_RESOLUTION,
@@ -37,8 +37,9 @@ from rpr3gen.errors import (
     TrajectoryError,
     did_you_mean,
 )
-from rpr3gen.model import ACTUATIONS, Model, load_model
+from rpr3gen.model import Model, load_model
 from rpr3gen.policy import DEFAULT_MIN_CONDITIONING, Invalid, invalid_samples
+from rpr3gen.structure import LEG_TYPES, Structure
 from rpr3gen.trajectory import (
     DEFAULT_DURATION,
     DEFAULT_SAMPLES,
@@ -319,14 +320,38 @@ def _parser() -> argparse.ArgumentParser:
         f"{DEFAULT_MIN_CONDITIONING:g})",
     )
 
-    gen = sub.add_parser("generate", help="derive and write the generated sources")
+    gen = sub.add_parser(
+        "generate",
+        help="derive and write the generated sources",
+        description="Derive and write generated code. Without --leg or --model: the committed "
+        "variants (the paper's revolute and prismatic, and rrr_1) into the source tree's "
+        "generated/. With --leg and --actuated (or --model): that one structure's variant, into "
+        "--out DIR, or by default into the cache where the runtime finds it (see "
+        "RPR3GEN_CACHE_DIR).",
+    )
     gen.add_argument(
         "--model",
         metavar="FILE",
-        help="generate only this model's actuation (default: both actuations)",
+        help="generate only this model's variant (default: the committed variants)",
     )
     gen.add_argument(
-        "--out", metavar="DIR", help="output folder (default: the source tree's generated/)"
+        "--leg",
+        metavar="TYPE",
+        help="generate the variant of this leg type (RRR RPR RRP PRR PPR PRP RPP); needs the "
+        "actuated joint too (default: the committed variants)",
+    )
+    gen.add_argument(
+        "--actuated",
+        type=int,
+        metavar="J",
+        help="the joint (1, 2 or 3) of every leg that carries its motor; needs the leg type "
+        "too (default: none)",
+    )
+    gen.add_argument(
+        "--out",
+        metavar="DIR",
+        help="output folder (default: the source tree's generated/, or the cache for one "
+        "structure)",
     )
     gen.add_argument(
         "--check",
@@ -371,7 +396,7 @@ def _screen(
     Returns:
         The samples blanked (written as NaN), or None when every sample is valid.
     """
-    thresholds = manifest.load(model.actuation, model.generated).thresholds
+    thresholds = variants.load(model.structure, model.generated).thresholds
     invalid = invalid_samples(model, traj.q, out, min_conditioning, thresholds)
     if invalid is None:
         return None
@@ -381,7 +406,7 @@ def _screen(
             f"t = {traj.t[k]:.6g} s (sample {k + 1} of {len(traj.t)}): {invalid.reason}; "
             "pass --allow-invalid to write such rows as NaN"
         )
-    for name in OUTPUT_NAMES:
+    for name in output_names(model):
         if name != "conditioning":
             out[name] = np.where(invalid.mask, np.nan, out[name])
     return invalid
@@ -482,7 +507,7 @@ def simulate(
     invalid = _screen(model, traj, out, min_conditioning, allow_invalid)
     if out_csv:
         Path(out_csv).parent.mkdir(parents=True, exist_ok=True)
-        write_results_csv(out_csv, traj.t, traj.q, out, OUTPUT_NAMES)
+        write_results_csv(out_csv, traj.t, traj.q, out, output_names(model))
     if plots_dir:
         from rpr3gen.plots import plot_families
 
@@ -492,7 +517,7 @@ def simulate(
             plots_dir,
             prefix=name,
             title=f"{name} ({model.name})",
-            actuation=model.actuation,
+            actuation=model.structure,
         )
     return out, invalid
 
@@ -510,7 +535,12 @@ def _summary(
         valid = n - int(np.count_nonzero(invalid.mask))
         lines.append(f"  {_refused(traj, invalid)}; the peaks are of the {valid} others")
     lines.append(f"  {'peak |value|':<12} {'leg A':>12} {'leg B':>12} {'leg C':>12}")
-    for family in ("m10", "f21z", "f10x", "f10y", "f21y", "m21", "f32y", "f32z"):
+    families = (
+        ("m10", "f21z", "f10x", "f10y", "f21y", "m21", "f32y", "f32z")
+        if model.structure.paper
+        else ("tau", *(f"{f}{j}" for j in (1, 2, 3) for f in ("fx", "fy", "m")))
+    )
+    for family in families:
         peaks = [float(np.nanmax(np.abs(out[f"{family}_{leg}"]), initial=0.0)) for leg in "ABC"]
         lines.append(f"  {family:<12} " + " ".join(f"{p:12.5g}" for p in peaks))
     return "\n".join(lines)
@@ -576,10 +606,11 @@ def _cmd_fk(args: argparse.Namespace) -> int:
     conditioning = (
         inverse_dynamics(model, modes, zero, zero)["conditioning"] if len(modes) else zero
     )
-    family = "phi10" if model.actuation == "revolute" else "lambda21"
+    family = model.structure.actuator
+    what = f"{model.actuation} actuation" if model.structure.paper else model.structure.title
     print(
         f"# {len(modes)} assembly mode(s) of {family} = {' '.join(f'{v:g}' for v in qa)} "
-        f"({model.name}, {model.actuation} actuation): x y phi conditioning"
+        f"({model.name}, {what}): x y phi conditioning"
     )
     for mode, c in zip(modes, conditioning, strict=True):
         print(f"{mode[0]:.12g} {mode[1]:.12g} {mode[2]:.12g} {c:.6g}")
@@ -655,19 +686,34 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
 def _cmd_generate(args: argparse.Namespace) -> int:
     try:
         from rpr3gen_derive.codegen import files as codegen_files
-        from rpr3gen_derive.rpr3 import generate
+        from rpr3gen_derive.planar import generate, structures
     except ImportError as exc:
         raise Rpr3genError(
             f"regeneration needs sympy and jinja2 ({exc.name} is missing): "
             "pip install 'rpr3gen[derive]'"
         ) from exc
-    actuations: tuple[str, ...] = ACTUATIONS
-    if args.model:
-        actuations = (load_model(args.model).actuation,)
-    out_dir = Path(args.out) if args.out else generate.default_out_dir()
-    if out_dir is None:
-        raise Rpr3genError("no source tree's generated/ folder here; name one with --out DIR")
-    files = generate.render(actuations)
+    one = _generated_structure(args)
+    if one is not None:
+        if one.singular:
+            raise Rpr3genError(
+                f"--actuated: a {one.title} cannot move: both its passive joints are prismatic "
+                "(architecturally singular); nothing to generate"
+            )
+        target = structures.Structure(one.leg, one.actuated, one.paper)
+        committed = target in generate.COMMITTED
+        if args.out:
+            out_dir = Path(args.out)
+        elif committed and generate.default_out_dir() is not None:
+            out_dir = generate.default_out_dir()
+        else:
+            out_dir = variants.folder(one)
+        package = generate.COMMITTED if committed and not args.out else (target,)
+        files = generate.render((target,), package=package)
+    else:
+        out_dir = Path(args.out) if args.out else generate.default_out_dir()
+        if out_dir is None:
+            raise Rpr3genError("no source tree's generated/ folder here; name one with --out DIR")
+        files = generate.render(generate.COMMITTED)
     if args.check:
         stale = codegen_files.stale_files(out_dir, files)
         if stale:
@@ -680,6 +726,27 @@ def _cmd_generate(args: argparse.Namespace) -> int:
     changed = codegen_files.write_files(out_dir, files)
     print(f"{out_dir}: {len(changed)} of {len(files)} files changed")
     return 0
+
+
+def _generated_structure(args: argparse.Namespace) -> Structure | None:
+    """The one structure ``rpr3gen generate`` was asked for, or None for the committed ones."""
+    if args.leg is not None or args.actuated is not None:
+        if args.model:
+            raise InputError("--model: not together with --leg and --actuated")
+        if args.leg is None or args.actuated is None:
+            raise InputError("--leg and --actuated go together")
+        leg = str(args.leg).upper()
+        if leg not in LEG_TYPES:
+            hint = did_you_mean(leg, LEG_TYPES)
+            raise InputError(
+                f"--leg: must be one of {', '.join(LEG_TYPES)}, got {args.leg!r}{hint}"
+            )
+        if args.actuated not in (1, 2, 3):
+            raise InputError(f"--actuated: must be 1, 2 or 3, got {args.actuated}")
+        return Structure(leg, args.actuated)
+    if args.model:
+        return load_model(args.model).structure
+    return None
 
 
 def main(argv: Sequence[str] | None = None) -> int:

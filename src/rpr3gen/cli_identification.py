@@ -172,7 +172,7 @@ def cmd_identify(args: argparse.Namespace) -> int:
         out = Path(args.out)
         if out.is_dir():
             raise Rpr3genError(f"{out}: cannot write the estimates: it is a folder")
-    family = EFFORT[model.actuation]
+    family = model.structure.effort
     columns = tuple(f"{family}_{leg}" for leg in LEGS)
     traj, tau = read_trajectory_columns(args.data, columns, smoothing=args.smoothing)
     fit = identify(
@@ -191,6 +191,7 @@ def cmd_identify(args: argparse.Namespace) -> int:
         with atomic_write(args.out) as f:
             f.write(fit_toml(fit, model, args.data))
     unit = UNIT[model.actuation]
+    what = f"{model.actuation} actuation" if model.structure.paper else model.structure.title
     legs = "identical legs" if args.identical_legs else "per leg"
     base_values = _model_base(fit)
     expressions = fit.base.expressions(4)
@@ -199,7 +200,7 @@ def cmd_identify(args: argparse.Namespace) -> int:
     )
     print(
         f"identify: {fit.samples} samples of {args.data}, model {model.name} "
-        f"({model.actuation} actuation), {len(fit.base.names)} base parameters ({legs})"
+        f"({what}), {len(fit.base.names)} base parameters ({legs})"
         + (" + 6 friction" if args.friction else "")
     )
     print(
@@ -237,12 +238,18 @@ def cmd_excite(args: argparse.Namespace) -> int:
     )
     out.parent.mkdir(parents=True, exist_ok=True)
     write_trajectory_csv(out, found.trajectory)
-    lo, hi = found.stroke.min(), found.stroke.max()
+    if model.structure.paper:
+        lo, hi = found.stroke.min(), found.stroke.max()
+        bounds = f"piston strokes within [{lo:.4g}, {hi:.4g}] m"
+    else:
+        bounds = f"min reach {found.min_reach:.3g}" + "".join(
+            f", {name} in [{lo:.4g}, {hi:.4g}]" for name, (lo, hi) in found.ranges.items()
+        )
     print(
         f"excite: {model.name}, {args.harmonics} harmonics, period {args.period:g} s: condition "
         f"number {found.initial_condition_number:.4g} -> {found.condition_number:.4g} "
         f"({found.iterations} iterations); min conditioning {found.min_conditioning:.3g}, "
-        f"piston strokes within [{lo:.4g}, {hi:.4g}] m"
+        f"{bounds}"
     )
     print(f"wrote {args.out}")
     return 0

@@ -54,7 +54,12 @@ SAME_MODE = 1e-9
 def platform_radius(model: Model) -> float:
     """``rho``: the platform's RMS joint radius (m), which turns ``phi`` into a distance."""
     p = model.params
-    return math.sqrt(sum(p[f"x{leg}3"] ** 2 + p[f"y{leg}3"] ** 2 for leg in LEGS) / 3)
+    names = (
+        [(f"x{leg}3", f"y{leg}3") for leg in LEGS]
+        if model.structure.paper
+        else [(f"x3_{leg}", f"y3_{leg}") for leg in LEGS]
+    )
+    return math.sqrt(sum(p[x] ** 2 + p[y] ** 2 for x, y in names) / 3)
 
 
 def actuator_coordinates(model: Model, q: ArrayLike, backend: str = "numpy") -> np.ndarray:
@@ -121,12 +126,14 @@ def _wrap(angle: np.ndarray) -> np.ndarray:
 def _residual(model: Model, q: np.ndarray, qa: np.ndarray, backend: str) -> np.ndarray:
     """``qa(q) - qa`` for each row of q, angles wrapped (NaN where a pose is refused)."""
     r = actuator_coordinates(model, q, backend) - qa
-    return _wrap(r) if model.actuation == "revolute" else r
+    return _wrap(r) if model.structure.actuated_kind == "R" else r
 
 
 def _polish(model: Model, q: np.ndarray, qa: np.ndarray, backend: str) -> np.ndarray:
     """Newton steps on ``qa(q) = qa`` for candidate poses (k, 3); rows that do not converge
     to :data:`POLISH_TOL` become NaN."""
+    if not len(q):
+        return q.reshape(0, 3)
     q = q.copy()
     for _ in range(POLISH_STEPS):
         r = _residual(model, q, qa, backend)
@@ -177,17 +184,20 @@ def assembly_modes(model: Model, qa: ArrayLike, backend: str = "numpy") -> np.nd
     """Every assembly mode of the actuator coordinates ``qa`` (3,): (k, 3) poses, ``phi`` in
     ``(-pi, pi]``, sorted by ``phi``.
 
-    ``k <= 2`` with revolute actuation (closed form), ``k <= 6`` with prismatic (the sextic).
-    A mode has every leg of positive length along its axis (docs/interfaces.md) and, as
-    everywhere in rpr3gen, is a pose the generated code evaluates: every piston joint in front of
-    its base pivot (``reach`` above the generated ``MIN_REACH``) and ``conditioning`` above
-    ``MIN_CONDITIONING`` (a mode at a parallel singularity, a double one, is refused as
-    :func:`rpr3gen.inverse_dynamics` refuses it); stroke limits are not applied.
+    ``k <= 2`` where the locked legs hold the platform on lines (closed form: the paper's
+    revolute actuation), ``k <= 6`` on circles (the sextic: the paper's prismatic actuation, the
+    3-RRR with base motors...). A mode has every leg in its working mode (docs/interfaces.md)
+    and, as everywhere in rpr3gen, is a pose the generated code evaluates: ``reach`` above the
+    generated ``MIN_REACH`` (the paper: every piston joint in front of its base pivot) and
+    ``conditioning`` above ``MIN_CONDITIONING`` (a mode at a parallel singularity, a double one,
+    is refused as :func:`rpr3gen.inverse_dynamics` refuses it); joint limits are not applied.
     """
     row = samples("qa", qa, 3)[0]
-    if model.actuation == "revolute":
+    if model.structure.hold != "circle":
         (modes, margins), _ = evaluate(model, "assembly_modes", (row,), backend)
-        found = modes.reshape(2, 3)[margins[0] >= 0]
+        # A candidate is a mode where every leg is in its working mode: Newton, from an exact
+        # candidate, converges at once; from one with a leg in another mode it does not.
+        found = _polish(model, modes.reshape(2, 3)[margins[0] >= 0], row, backend)
     else:
         (a,), _ = evaluate(model, "assembly_modes", (row,), backend)
         angles = _sextic_angles(a[0])

@@ -25,7 +25,7 @@ from functools import lru_cache
 import numpy as np
 import scipy.optimize
 
-from rpr3gen import manifest
+from rpr3gen import variants
 from rpr3gen.backends import evaluate
 from rpr3gen.control import platform_radius
 from rpr3gen.errors import IdentificationError, InputError
@@ -36,6 +36,7 @@ from rpr3gen.identification import (
     shared_matrix,
 )
 from rpr3gen.model import LEGS, Model
+from rpr3gen.policy import joint_limits
 from rpr3gen.trajectory import Trajectory
 
 __all__ = ["Excitation", "FourierMotion", "excite"]
@@ -87,7 +88,10 @@ class Excitation:
         initial_condition_number: cond(W) of the starting motion.
         iterations: SLSQP iterations.
         min_conditioning: the smallest ``conditioning`` along the motion.
-        stroke: (3, 2) the piston displacement range of each leg along the motion (m).
+        ranges: ``{output name: (lo, hi)}``, the range along the motion of each joint
+            coordinate the constraints bound (the paper's ``lambda21_A..C``; a general model's
+            limited coordinates).
+        min_reach: the smallest ``reach`` along the motion (away from serial singularities).
     """
 
     motion: FourierMotion
@@ -96,14 +100,28 @@ class Excitation:
     initial_condition_number: float
     iterations: int
     min_conditioning: float
-    stroke: np.ndarray
+    ranges: dict[str, tuple[float, float]]
+    min_reach: float
+
+    @property
+    def stroke(self) -> np.ndarray:
+        """(k, 2): :attr:`ranges` as an array (the paper: each leg's piston displacements)."""
+        return np.array(list(self.ranges.values()), dtype=float).reshape(-1, 2)
 
 
-def _stroke(model: Model) -> np.ndarray:
-    if model.stroke is not None:
-        return np.array(model.stroke, dtype=float)
-    half = model.params["l0"] / 2
-    return np.array([[-half, half]] * len(LEGS))
+#: A general model without ``[limits]`` keeps its legs at least this far from a serial
+#: singularity (``reach``, 1 at home) along an exciting motion.
+MIN_REACH = 0.3
+
+
+def _limits(model: Model) -> list[tuple[str, float, float]]:
+    """``(output name, lo, hi)`` of each bounded joint coordinate: the model's limits, or the
+    paper's default ``|lambda21| <= l0 / 2``."""
+    limits = [(f"{family}_{leg}", lo, hi) for leg, family, lo, hi in joint_limits(model)]
+    if not limits and model.structure.paper:
+        half = model.params["l0"] / 2
+        limits = [(f"lambda21_{leg}", -half, half) for leg in LEGS]
+    return limits
 
 
 @one_blas_thread
@@ -149,7 +167,8 @@ def excite(
         raise InputError(f"min_conditioning must be in [0, 1), got {min_conditioning!r}")
     base = base_parameters(model, identical_legs)
     columns = list(base.columns)
-    stroke = _stroke(model)
+    limits = _limits(model)
+    stroke = np.array([[lo, hi] for _, lo, hi in limits]).reshape(-1, 2)
     t = np.linspace(0.0, period, samples)
     rho = platform_radius(model)
     acc = np.array([max_acceleration[0], max_acceleration[0], max_acceleration[1]], dtype=float)
@@ -168,9 +187,11 @@ def excite(
         return FourierMotion.from_vector(u * scale, period, harmonics)
 
     names = _output_index(model)
-    rate_family = "omega10" if model.actuation == "revolute" else "v21"
+    rate_family = model.structure.rate(model.structure.actuated)
     conditioning_column = names["conditioning"]
-    stroke_columns = [names[f"lambda21_{leg}"] for leg in LEGS]
+    reach_column = names["reach"]
+    min_reach = 0.0 if model.structure.paper else MIN_REACH
+    stroke_columns = [names[name] for name, _, _ in limits]
     rate_columns = [names[f"{rate_family}_{leg}"] for leg in LEGS]
 
     @lru_cache(maxsize=64)  # SLSQP asks for f and the constraints at the same points
@@ -182,7 +203,7 @@ def excite(
         if identical_legs:
             Y = Y @ shared_matrix()
         W = Y[..., columns]
-        if friction:  # the actuator rates are the inverse dynamics' omega10 or v21
+        if friction:  # the actuator rates, from the inverse dynamics
             W = np.concatenate([W, friction_columns_of_rates(out[:, rate_columns])], axis=2)
         return W.reshape(-1, W.shape[2]), out, codes, qdd
 
@@ -216,6 +237,7 @@ def excite(
         width = np.ptp(stroke, axis=1)
         parts = [
             np.where(codes == 0, cond - min_conditioning, -1.0),
+            np.where(codes == 0, out[:, reach_column] - min_reach, -1.0),
             (np.where(ok, lam - stroke[:, 0], -1.0) / width).ravel(),
             (np.where(ok, stroke[:, 1] - lam, -1.0) / width).ravel(),
             (1.0 - np.abs(qdd) / acc).ravel(),
@@ -233,8 +255,8 @@ def excite(
         start[3:] *= 0.5
     else:
         raise IdentificationError(
-            "excite: the central configuration itself violates the constraints (stroke, "
-            "conditioning); relax them"
+            "excite: the central configuration itself violates the constraints (joint "
+            "limits, conditioning, reach); relax them"
         )
     initial = math.exp(log_cond(start))
     result = scipy.optimize.minimize(
@@ -249,7 +271,7 @@ def excite(
     found = motion(chosen)
     traj = found.trajectory(samples)
     (out,), _ = evaluate(model, "inverse_dynamics", (traj.q, traj.qd, traj.qdd))
-    lam = out[:, [names[f"lambda21_{leg}"] for leg in LEGS]]
+    lam = out[:, stroke_columns]
     return Excitation(
         motion=found,
         trajectory=traj,
@@ -257,10 +279,14 @@ def excite(
         initial_condition_number=initial,
         iterations=int(result.nit),
         min_conditioning=float(out[:, names["conditioning"]].min()),
-        stroke=np.stack([lam.min(axis=0), lam.max(axis=0)], axis=1),
+        ranges={
+            name: (float(lo), float(hi))
+            for (name, _, _), lo, hi in zip(limits, lam.min(axis=0), lam.max(axis=0), strict=True)
+        },
+        min_reach=float(out[:, reach_column].min()),
     )
 
 
 def _output_index(model: Model) -> dict[str, int]:
-    info = manifest.load(model.actuation, model.generated).function("inverse_dynamics")
+    info = variants.load(model.structure, model.generated).function("inverse_dynamics")
     return {name: k for k, name in enumerate(info.outputs[0].names)}

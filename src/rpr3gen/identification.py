@@ -28,7 +28,7 @@ import scipy.linalg
 from numpy.typing import ArrayLike
 from threadpoolctl import threadpool_limits
 
-from rpr3gen import manifest
+from rpr3gen import variants
 from rpr3gen.backends import evaluate, samples
 from rpr3gen.control import actuator_jacobian, platform_radius
 from rpr3gen.errors import IdentificationError, InputError, Rpr3genError
@@ -119,26 +119,54 @@ def shared_matrix() -> np.ndarray:
 def inertial_parameters(model: Model, identical_legs: bool = False) -> np.ndarray:
     """The model's ``pi`` (P,), in the order of :func:`parameter_names`.
 
-    Cylinder: ``m1, m1 c1, m1 c1_perp, J1 + m1 (c1^2 + c1_perp^2)`` (about A1); piston:
-    ``m2, m2 c2, m2 c2_perp, J2 + m2 (c2^2 + c2_perp^2)`` (about A2); platform ``m3, 0, 0, J3``
-    (centre of mass at G). A model file describes one leg for all three, so its legs are always
-    identical and ``identical_legs`` is accepted.
+    The paper's format: cylinder ``m1, m1 c1, m1 c1_perp, J1 + m1 (c1^2 + c1_perp^2)`` (about
+    A1, x along the leg axis); piston ``m2, m2 c2, m2 c2_perp, J2 + m2 (c2^2 + c2_perp^2)``
+    (about A2); platform ``m3, 0, 0, J3`` (centre of mass at G). Its model file describes one
+    leg for all three, so ``identical_legs`` is accepted. The general format: per body, ``m``,
+    ``m (c - P)`` (its centre of mass from its first joint point at home, world axes) and
+    ``J + m |c - P|^2``; the platform's about G in the platform frame. ``identical_legs`` then
+    needs the three legs' values equal (legs turned by 120 degrees are not: their first moments
+    point other ways in the world's axes).
+
+    Raises:
+        InputError: ``identical_legs`` with a general model whose legs' parameters differ.
     """
     p = model.params
 
     def body(m: float, c: float, c_perp: float, j: float) -> list[float]:
         return [m, m * c, m * c_perp, j + m * (c**2 + c_perp**2)]
 
-    cylinder = body(p["m1"], p["c1"], p["c1_perp"], p["J1"])
-    piston = body(p["m2"], p["c2"], p["c2_perp"], p["J2"])
-    platform = [p["m3"], 0.0, 0.0, p["J3"]]
-    legs = 1 if identical_legs else len(LEGS)
-    return np.array((cylinder + piston) * legs + platform, dtype=float)
+    if model.structure.paper:
+        cylinder = body(p["m1"], p["c1"], p["c1_perp"], p["J1"])
+        piston = body(p["m2"], p["c2"], p["c2_perp"], p["J2"])
+        platform = [p["m3"], 0.0, 0.0, p["J3"]]
+        legs = 1 if identical_legs else len(LEGS)
+        return np.array((cylinder + piston) * legs + platform, dtype=float)
+    per_leg = []
+    for leg in LEGS:
+        values = []
+        for k in (1, 2):
+            dx = p[f"cx{k}_{leg}"] - p[f"x{k}_{leg}"]
+            dy = p[f"cy{k}_{leg}"] - p[f"y{k}_{leg}"]
+            values += body(p[f"m{k}_{leg}"], dx, dy, p[f"J{k}_{leg}"])
+        per_leg.append(values)
+    platform = body(p["m3"], p["cx3"], p["cy3"], p["J3"])
+    if identical_legs:
+        first = np.array(per_leg[0])
+        for leg, values in zip(LEGS[1:], per_leg[1:], strict=True):
+            if not np.allclose(values, first, rtol=1e-12, atol=1e-15):
+                raise InputError(
+                    f"identical_legs: leg {leg}'s inertial parameters differ from leg A's "
+                    "(the general format's first moments are in the world's axes, so legs "
+                    "turned by 120 degrees differ); identify per leg"
+                )
+        return np.array(per_leg[0] + platform, dtype=float)
+    return np.array([v for values in per_leg for v in values] + platform, dtype=float)
 
 
 def _check_names(model: Model) -> None:
     """The generated regressor's columns are :data:`INERTIAL_PARAMETER_NAMES`."""
-    variant = manifest.load(model.actuation, model.generated)
+    variant = variants.load(model.structure, model.generated)
     names = variant.tables.get(f"{variant.prefix}_inertial_parameter_names")
     if names != INERTIAL_PARAMETER_NAMES:
         raise Rpr3genError(

@@ -28,6 +28,7 @@ import numpy as np
 
 from rpr3gen import manifest
 from rpr3gen.errors import ModelError, Rpr3genError, did_you_mean
+from rpr3gen.structure import PAPER_PARAM_NAMES, Structure
 
 __all__ = [
     "ACTUATIONS",
@@ -43,8 +44,9 @@ __all__ = [
 ACTUATIONS: tuple[str, ...] = ("revolute", "prismatic")
 """Which joint of each leg is driven: the base revolute (the paper) or the prismatic joint."""
 
-PARAM_NAMES: tuple[str, ...] = manifest.load(ACTUATIONS[0]).param_names
-"""Names of the model parameters, in the order of the generated code's ``params`` array."""
+PARAM_NAMES: tuple[str, ...] = PAPER_PARAM_NAMES
+"""Names of the paper format's model parameters, in the order of the generated code's
+``params`` array (a general model's are its structure's, :meth:`Structure.param_names`)."""
 
 LEGS: tuple[str, ...] = ("A", "B", "C")
 
@@ -103,21 +105,28 @@ class _ReadOnlyParams(Mapping[str, float]):
 
 @dataclass(frozen=True)
 class Model:
-    """A validated 3-RPR robot.
+    """A validated robot, of the paper's format or the general one.
 
     Attributes:
         name: The model's name (``name`` in the file).
-        actuation: ``"revolute"`` (motors at the base pivots, the paper) or ``"prismatic"``.
-        params: Read-only mapping with exactly :data:`PARAM_NAMES`, in that order, as floats in
-            SI units: base pivots ``xA1..yC1`` (m, world frame), platform joints ``xA3..yC3``
+        actuation: ``"revolute"`` (motors on revolute joints: the paper's base motors) or
+            ``"prismatic"``: the kind of the actuated joint.
+        params: Read-only mapping with exactly the structure's parameter names
+            (:meth:`Structure.param_names`), in that order, as floats in SI units. The paper's
+            format: base pivots ``xA1..yC1`` (m, world frame), platform joints ``xA3..yC3``
             (m, platform frame), ``alpha_A..alpha_C`` (rad), lengths (m), masses (kg),
             inertias (kg m², about the COM, axis z), gravity ``gx, gy`` (m/s²) and the payload
-            wrench at G ``fx, fy`` (N), ``mz`` (N m).
+            wrench at G ``fx, fy`` (N), ``mz`` (N m). The general format: docs/interfaces.md.
         source: Where the model came from (a file path or ``"<dict>"``), for messages.
-        stroke: Optional piston displacement bounds ``((lo, hi), ...)`` for legs A, B, C (m,
-            bounds on lambda21), from ``[limits] stroke``; None when the file sets none.
+        stroke: The paper's format: optional piston displacement bounds ``((lo, hi), ...)``
+            for legs A, B, C (m, bounds on lambda21), from ``[limits] stroke``; else None.
         generated: The folder of generated code that evaluates this model (written by
-            ``rpr3gen generate --out DIR``), or None for the installed package.
+            ``rpr3gen generate --out DIR``), or None for the installed package (and the cache
+            of variants generated on first use).
+        structure: The leg type and actuated joint (and the format); None (only when built by
+            hand) means the paper's of ``actuation``.
+        limits: The general format: joint coordinate bounds ``{"A.q2": (lo, hi), ...}`` (m or
+            rad) from ``[limits]``; None when the file sets none.
     """
 
     name: str
@@ -126,38 +135,90 @@ class Model:
     source: str
     stroke: tuple[tuple[float, float], ...] | None = None
     generated: str | None = None
+    # Always a Structure after construction (None at construction means the paper's).
+    structure: Structure = None  # type: ignore[assignment]
+    limits: Mapping[str, tuple[float, float]] | None = None
 
     def __post_init__(self) -> None:
-        if self.actuation not in ACTUATIONS:
+        if self.structure is None or self.structure.paper:
+            # The paper's format: its actuation picks the variant (dataclasses.replace of
+            # actuation alone switches it).
+            if self.actuation not in ACTUATIONS:
+                raise ModelError(
+                    f"{self.source}: actuation: must be one of {_quoted(ACTUATIONS)}, "
+                    f"got {_describe(self.actuation)}"
+                )
+            object.__setattr__(self, "structure", Structure.of_variant(self.actuation))
+        elif self.actuation != self.structure.actuation:
             raise ModelError(
-                f"{self.source}: actuation: must be one of {_quoted(ACTUATIONS)}, "
-                f"got {_describe(self.actuation)}"
+                f"{self.source}: actuation: a {self.structure.title} has "
+                f"{self.structure.actuation} motors, not {_describe(self.actuation)}"
             )
-        if set(self.params) != set(PARAM_NAMES):
-            missing = [n for n in PARAM_NAMES if n not in self.params]
-            extra = sorted(set(self.params) - set(PARAM_NAMES))
+        names = self.structure.param_names()
+        if set(self.params) != set(names):
+            missing = [n for n in names if n not in self.params]
+            extra = sorted(set(self.params) - set(names))
             raise ModelError(f"{self.source}: params: missing {missing}, unexpected {extra}")
-        ordered = _ReadOnlyParams({n: float(self.params[n]) for n in PARAM_NAMES})
+        ordered = _ReadOnlyParams({n: float(self.params[n]) for n in names})
         object.__setattr__(self, "params", ordered)
+        if self.limits is not None:
+            object.__setattr__(self, "limits", _ReadOnlyLimits(self.limits))
         if self.generated is not None:
             object.__setattr__(self, "generated", os.fspath(self.generated))
             try:
-                variant = manifest.load(self.actuation, self.generated)
+                variant = manifest.load(self.variant, self.generated)
             except Rpr3genError as exc:
                 raise ModelError(f"generated code: {exc}") from None
-            if variant.param_names != PARAM_NAMES:
+            if variant.param_names != names:
                 raise ModelError(
                     f"{variant.folder}: generated for other model parameters than this "
                     "runtime's; regenerate it with this version"
                 )
 
-    def vector(self, names: Sequence[str] = PARAM_NAMES) -> np.ndarray:
-        """Return the parameters ``names`` as a new float64 array of shape ``(len(names),)``.
+    @property
+    def variant(self) -> str:
+        """The generated variant that evaluates this model (a folder name: ``revolute``,
+        ``rrr_1``, ...)."""
+        return self.structure.variant
+
+    @property
+    def param_names(self) -> tuple[str, ...]:
+        """The model's parameter names, in the generated code's order."""
+        return tuple(self.params)
+
+    def vector(self, names: Sequence[str] | None = None) -> np.ndarray:
+        """Return the parameters ``names`` (default: all, in order) as a new float64 array.
 
         Raises:
-            KeyError: If a name is not one of :data:`PARAM_NAMES`.
+            KeyError: If a name is not one of the model's parameters.
         """
+        names = tuple(self.params) if names is None else names
         return np.array([self.params[n] for n in names], dtype=np.float64)
+
+
+class _ReadOnlyLimits(Mapping[str, tuple[float, float]]):
+    """An immutable, hashable ``"A.q2" -> (lo, hi)`` mapping in sorted key order."""
+
+    def __init__(self, items: Mapping[str, tuple[float, float]]) -> None:
+        self._data = {k: (float(v[0]), float(v[1])) for k, v in sorted(items.items())}
+
+    def __getitem__(self, key: str) -> tuple[float, float]:
+        return self._data[key]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._data)
+
+    def __len__(self) -> int:
+        return len(self._data)
+
+    def __hash__(self) -> int:
+        return hash(tuple(self._data.items()))
+
+    def __eq__(self, other: object) -> bool:
+        return isinstance(other, Mapping) and dict(self.items()) == dict(other.items())
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}({self._data!r})"
 
 
 def load_model(
@@ -234,6 +295,10 @@ def model_from_dict(data: Mapping[str, Any], source: str = "<dict>") -> Model:
     Raises:
         ModelError: On the first problem found, naming ``source`` and the dotted key.
     """
+    if isinstance(data, Mapping) and "leg" in data:
+        from rpr3gen.general_model import read_general
+
+        return read_general(data, source)
     return _Reader(source).read(data)
 
 
@@ -380,9 +445,10 @@ class _Reader:
         dotted: str,
         key: str,
         shape: str = "a list of 3 points [[x, y], [x, y], [x, y]]",
+        count: int = 3,
     ) -> list[tuple[float, ...]]:
         value = _as_list(table[key])
-        if not isinstance(value, list) or len(value) != 3:
+        if not isinstance(value, list) or len(value) != count:
             self.fail(dotted, f"must be {shape}, got {_describe(table[key])}")
         return [self.vector({"p": p}, f"{dotted}[{i}]", "p", 2) for i, p in enumerate(value)]
 

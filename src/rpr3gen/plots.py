@@ -25,6 +25,7 @@ from matplotlib.figure import Figure
 from rpr3gen.atomic import atomic_write
 from rpr3gen.errors import InputError
 from rpr3gen.model import ACTUATIONS, LEGS
+from rpr3gen.structure import Structure
 
 __all__ = [
     "DPI",
@@ -114,12 +115,39 @@ _LEG_VARIABLES = (
 )
 
 
-def plotted_families(actuation: str) -> tuple[FamilyPlot, ...]:
-    """The families :func:`plot_families` draws for a robot with the given actuation, in order.
+def _general_families(structure: Structure) -> tuple[FamilyPlot, ...]:
+    """The general format's figures: every joint's force components, the moments that are not
+    zero by construction (a passive revolute joint transmits none), the actuator efforts and
+    the joint coordinates."""
+    out = []
+    for j in (1, 2, 3):
+        out.append(FamilyPlot(f"fx{j}", f"Joint {j} forces", rf"$f_{{x{j}}}$", "N"))
+        out.append(FamilyPlot(f"fy{j}", f"Joint {j} forces", rf"$f_{{y{j}}}$", "N"))
+        if structure.leg[j - 1] == "P" or j == structure.actuated:
+            out.append(FamilyPlot(f"m{j}", f"Joint {j} moments", rf"$m_{{{j}}}$", "N·m"))
+    unit = "N·m" if structure.actuated_kind == "R" else "N"
+    out.append(FamilyPlot("tau", "Actuator efforts", r"$\tau$", unit))
+    for j in (1, 2, 3):
+        kind = "rotations" if structure.leg[j - 1] == "R" else "displacements"
+        unit = "rad" if structure.leg[j - 1] == "R" else "m"
+        out.append(FamilyPlot(f"q{j}", f"Joint {j} {kind}", rf"$q_{{{j}}}$", unit))
+    return tuple(out)
+
+
+def plotted_families(actuation: str | Structure) -> tuple[FamilyPlot, ...]:
+    """The families :func:`plot_families` draws for a robot, in order.
+
+    Args:
+        actuation: The paper's ``"revolute"`` or ``"prismatic"``, or a model's structure (a
+            paper structure draws the paper's figures, a general one the general outputs').
 
     Raises:
-        InputError: If ``actuation`` is not ``"revolute"`` or ``"prismatic"``.
+        InputError: If ``actuation`` is not one of these.
     """
+    if isinstance(actuation, Structure):
+        if not actuation.paper:
+            return _general_families(actuation)
+        actuation = actuation.variant
     if actuation not in ACTUATIONS:
         raise InputError(f"actuation must be one of {ACTUATIONS}, got {actuation!r}")
     return (*_PAPER_FAMILIES, _ACTUATOR[actuation], *_LEG_VARIABLES)
@@ -132,12 +160,13 @@ def plot_families(
     *,
     prefix: str,
     title: str,
-    actuation: str,
+    actuation: str | Structure,
 ) -> list[Path]:
     """Write one PNG per output family, the legs A, B, C as three curves against time.
 
     Families: f10x, f10y, f21y, m21, f32y, f32z (the paper's figs 3-8 / 9-14), the actuator
-    load (m10 for revolute, f21z for prismatic actuation), phi10 and lambda21. Each file is
+    load (m10 for revolute, f21z for prismatic actuation), phi10 and lambda21; for a general
+    model, every joint's forces and non-zero moments, tau and the joint coordinates. Each file is
     ``{outdir}/{prefix}_{family}.png``, written atomically.
 
     Args:
@@ -146,7 +175,8 @@ def plot_families(
         outdir: Folder for the PNG files; created if missing.
         prefix: Start of every file name (e.g. the trajectory's name).
         title: Appended to every figure title after a dash (e.g. ``"rotation"``).
-        actuation: ``"revolute"`` or ``"prismatic"``; selects the actuator-load figure.
+        actuation: ``"revolute"`` or ``"prismatic"`` (the paper's figures, with that actuator
+            load), or a model's :class:`~rpr3gen.structure.Structure`.
 
     Returns:
         The paths written, in the order of :func:`plotted_families`.

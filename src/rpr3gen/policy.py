@@ -143,6 +143,55 @@ def leg_extensions(model: Model, q: np.ndarray) -> np.ndarray:
     return np.stack(columns, axis=1)
 
 
+def joint_limits(model: Model) -> list[tuple[str, str, float, float]]:
+    """The model's joint limits as ``(leg, output family, lo, hi)``: the paper's piston strokes
+    (``lambda21``) or the general format's ``[limits]`` (``q2`` ...)."""
+    if model.stroke:
+        return [
+            (leg, "lambda21", lo, hi) for leg, (lo, hi) in zip(LEGS, model.stroke, strict=False)
+        ]
+    return [
+        (key.split(".")[0], key.split(".")[1], lo, hi)
+        for key, (lo, hi) in (model.limits or {}).items()
+    ]
+
+
+def _singular_reason(
+    model: Model,
+    q: np.ndarray,
+    conditioning: float,
+    min_conditioning: float,
+    thresholds: Mapping[str, float],
+) -> str:
+    """Why the pose ``q`` (3,) is refused: which leg, or how close to a parallel singularity."""
+    floor = thresholds["MIN_CONDITIONING"]
+    if model.structure.paper:
+        extension = leg_extensions(model, q[np.newaxis])[0]
+        k = int(np.argmin(extension))
+        if not extension[k] >= thresholds["MIN_REACH"] * model.params["l0"]:
+            return (
+                f"leg {LEGS[k]}: its piston joint {LEGS[k]}2 is on or behind its base pivot "
+                f"{LEGS[k]}1 (l0 + lambda21_{LEGS[k]} = {extension[k]:.6g} m), where the leg "
+                "folds onto the serial singularity |A1A3| = 0"
+            )
+    else:
+        from rpr3gen.backends import evaluate
+
+        (diagnostics,), _ = evaluate(model, "pose_diagnostics", (q,))
+        *reaches, conditioning = diagnostics[0]
+        for leg, r in zip(LEGS, reaches, strict=True):
+            if not np.isfinite(r):
+                return f"leg {leg} cannot reach this pose in its working mode"
+        k = int(np.argmin(reaches))
+        if not reaches[k] >= thresholds["MIN_REACH"]:
+            return (
+                f"leg {LEGS[k]} is at a serial singularity (reach {reaches[k]:.3g}: its joints' "
+                "motions dependent)"
+            )
+    what = "a singular pose" if not conditioning >= floor else f"conditioning {conditioning:.3g}"
+    return f"{what}, under the threshold {min_conditioning:g} (too close to a singularity)"
+
+
 def invalid_samples(
     model: Model,
     q: np.ndarray,
@@ -150,10 +199,10 @@ def invalid_samples(
     min_conditioning: float,
     thresholds: Mapping[str, float],
 ) -> Invalid | None:
-    """Samples that are singular, too close to a singularity, or outside a stroke limit.
+    """Samples that are singular, too close to a singularity, or outside a joint limit.
 
     Args:
-        model: the robot (its stroke limits).
+        model: the robot (its joint limits).
         q: (n, 3) the poses.
         out: the inverse dynamics' outputs (NaN where the generated code refused the sample).
         min_conditioning: refuse ``conditioning`` below this.
@@ -161,41 +210,36 @@ def invalid_samples(
             manifest), to say why it refused a sample.
     """
     conditioning = out["conditioning"]
+    limits = joint_limits(model)
     with np.errstate(invalid="ignore"):
         singular = ~(conditioning >= min_conditioning)
-        outside = {
-            leg: (out[f"lambda21_{leg}"] < lo) | (out[f"lambda21_{leg}"] > hi)
-            for leg, (lo, hi) in zip(LEGS, model.stroke or (), strict=False)
-        }
+        outside = [
+            (out[f"{family}_{leg}"] < lo) | (out[f"{family}_{leg}"] > hi)
+            for leg, family, lo, hi in limits
+        ]
     mask = singular.copy()
-    for leg_mask in outside.values():
-        mask |= leg_mask
+    for limit_mask in outside:
+        mask |= limit_mask
     if not mask.any():
         return None
     first = int(np.argmax(mask))
     if singular[first]:
-        extension = leg_extensions(model, q[first : first + 1])[0]
-        k = int(np.argmin(extension))
-        c = conditioning[first]
-        if not extension[k] >= thresholds["MIN_REACH"] * model.params["l0"]:
+        reason = _singular_reason(
+            model, q[first], float(conditioning[first]), min_conditioning, thresholds
+        )
+    else:
+        k = next(k for k, limit_mask in enumerate(outside) if limit_mask[first])
+        leg, family, lo, hi = limits[k]
+        value = out[f"{family}_{leg}"][first]
+        if family == "lambda21":
             reason = (
-                f"leg {LEGS[k]}: its piston joint {LEGS[k]}2 is on or behind its base pivot "
-                f"{LEGS[k]}1 (l0 + lambda21_{LEGS[k]} = {extension[k]:.6g} m), where the leg "
-                "folds onto the serial singularity |A1A3| = 0"
+                f"piston displacement lambda21_{leg} = {value:.6g} m "
+                f"outside its stroke [{lo:g}, {hi:g}]"
             )
         else:
-            floor = thresholds["MIN_CONDITIONING"]
-            what = "a singular pose" if not c >= floor else f"conditioning {c:.3g}"
+            unit = "rad" if model.structure.leg[int(family[1]) - 1] == "R" else "m"
             reason = (
-                f"{what}, under the threshold {min_conditioning:g} (too close to a singularity)"
+                f"joint coordinate {family}_{leg} = {value:.6g} {unit} "
+                f"outside its limits [{lo:g}, {hi:g}] (limits.{leg}.{family})"
             )
-    else:
-        assert model.stroke is not None
-        leg = next(leg for leg, leg_mask in outside.items() if leg_mask[first])
-        lo, hi = model.stroke[LEGS.index(leg)]
-        value = out[f"lambda21_{leg}"][first]
-        reason = (
-            f"piston displacement lambda21_{leg} = {value:.6g} m "
-            f"outside its stroke [{lo:g}, {hi:g}]"
-        )
     return Invalid(mask=mask, first=first, reason=reason)

@@ -17,7 +17,7 @@ import ctypes
 import numpy as np
 from numpy.typing import ArrayLike
 
-from rpr3gen import manifest, policy
+from rpr3gen import policy, variants
 from rpr3gen.errors import InputError, Rpr3genError
 from rpr3gen.evaluators import evaluator
 from rpr3gen.model import Model
@@ -38,7 +38,7 @@ class SampleEvaluator:
     def __init__(self, model: Model, backend: str = "c", function: str = "inverse_dynamics"):
         self.model = model
         self.backend = backend
-        variant = manifest.load(model.actuation, model.generated)
+        variant = variants.load(model.structure, model.generated)
         self.function = variant.function(function)
         self.codes = dict(variant.code_meanings)
         self.params = np.ascontiguousarray(model.vector(variant.param_names))

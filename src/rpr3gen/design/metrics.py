@@ -19,13 +19,13 @@ from typing import Any
 
 import numpy as np
 
+from rpr3gen import variants
 from rpr3gen.backends import BLOCK
 from rpr3gen.design.grid import Grid, design_model
 from rpr3gen.design.maps import cell_centres
 from rpr3gen.design.reach import design_stroke, pose_extent, reachable, within
 from rpr3gen.design.stacked import evaluate_stacked, param_rows
 from rpr3gen.errors import ModelError
-from rpr3gen.manifest import load as load_manifest
 from rpr3gen.model import LEGS, Model
 from rpr3gen.policy import invalid_samples
 from rpr3gen.trajectory import Trajectory
@@ -232,7 +232,7 @@ def _reason(
     lambda21: np.ndarray,
 ) -> str:
     """``"<trajectory>: t = <time> s: <why>"`` for the first pose at fault of one design."""
-    thresholds = load_manifest(model.actuation, model.generated).thresholds
+    thresholds = variants.load(model.structure, model.generated).thresholds
     for i, name in enumerate(plan.names):
         at = which == i
         out = {"conditioning": conditioning[at]}

@@ -15,7 +15,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from rpr3gen import manifest, policy
+from rpr3gen import policy, variants
 from rpr3gen.backends import BLOCK
 from rpr3gen.evaluators import evaluator
 from rpr3gen.model import LEGS, PARAM_NAMES, Model
@@ -81,7 +81,7 @@ def evaluate_stacked(
         Every output component by name, raw, and the return codes that the failure policy
         gives each sample (:func:`rpr3gen.policy.return_codes`).
     """
-    variant = manifest.load(model.actuation, model.generated)
+    variant = variants.load(model.structure, model.generated)
     info = variant.function(function)
     arrays = [np.ascontiguousarray(a, dtype=np.float64) for a in inputs]
     n = arrays[0].shape[0]

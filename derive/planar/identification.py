@@ -1,31 +1,23 @@
-"""Dynamic identification (issue 13): the actuator efforts as a linear regression on inertia.
+"""Dynamic identification: the actuator efforts as a linear regression on inertia, any structure.
 
 The required wrenches of eqs. (10)-(11) are linear in each body's mass ``m``, first moment
-``m c`` and inertia ``J`` about its joint point, and the loads of eqs. (12)-(17) are linear in
-the required wrenches (virtual work: the virtual velocities of eqs. (7)-(8) depend on the
-geometry alone). So the actuator efforts (``m10_*`` or ``f21z_*``) are
+``m c`` and inertia ``J`` about its first joint point, and the loads of eqs. (12)-(17) are
+linear in the required wrenches (virtual work: the virtual velocities of eqs. (7)-(8) depend on
+the geometry alone). So the actuator efforts are
 
     tau = Y(q, q', q'') @ pi + tau_payload(q),
 
-with, per moving body (cylinder 1 and piston 2 of legs A, B, C, then the platform 3), the four
-inertial parameters of :data:`INERTIAL_PARAMETER_NAMES`:
+with, per moving body (bodies 1 and 2 of legs A, B, C, then the platform 3), the four inertial
+parameters of :data:`INERTIAL_PARAMETER_NAMES`: ``m``; ``mcx``, ``mcy``, the first moment about
+the body's first joint point (the platform: G) in the body's frame of inertial parameters (the
+general format: the world's axes at home; the paper's legs: x along the leg axis e, y along
+its normal n; the platform: the platform frame); ``Jzz``, the moment of inertia about that
+point, axis z.
 
-- ``m``: mass;
-- ``mcx``, ``mcy``: first moment about the body's joint point, in the body's frame: x along the
-  leg axis e and y along its normal n for the cylinder (about A1) and the piston (about A2); the
-  platform frame's xG, yG for the platform (about G);
-- ``Jzz``: moment of inertia about the joint point (A1, A2, G), axis z0.
-
-:func:`regressor` rebuilds the required wrenches of eqs. (10)-(11) with these parameters as
-fresh symbols (``dynamics.required_wrench``, the body motions of ``dynamics.body_motions``),
-runs the same virtual-work solution (``virtual_work.joint_loads``, eqs. 7-8 and 12-17), and
-differentiates the efforts with respect to the parameters, assignment by assignment
-(``control.differentiate``). :func:`payload_efforts` is the same program at ``pi = 0``: the
-efforts that hold the payload wrench at rest, which depend on the pose only.
-
-:func:`base_parameters` is Gautier's numerical method on a stacked regressor (QR of the
-observation matrix); :func:`regroupings` and :func:`regrouping_matrix` state the regroupings
-found with it in closed form (docs/identification.md).
+:func:`regressor` runs the algorithm of eqs. (5)-(17) with these parameters as fresh symbols and
+differentiates the efforts with respect to them, assignment by assignment
+(:func:`~.calculus.differentiate`); :func:`payload_efforts` is the same program at ``pi = 0``,
+the efforts that hold the payload wrench at rest, a function of the pose only.
 """
 
 from __future__ import annotations
@@ -38,32 +30,28 @@ import numpy as np
 import scipy.linalg
 import sympy as sp
 from rpr3gen_derive.codegen.program import Program
-from rpr3gen_derive.rpr3 import symbols as syms
-from rpr3gen_derive.rpr3.control import ACTUATORS, at_zero, depends_on, differentiate
-from rpr3gen_derive.rpr3.derivation import algorithm
-from rpr3gen_derive.rpr3.dynamics import (
-    STEP_INERTIA,
-    STEP_RECURSION,
-    BodyMotion,
-    LegWrenches,
-    body_motions,
-    required_wrench,
-)
-from rpr3gen_derive.rpr3.frames import skew, u1, u3
-from rpr3gen_derive.rpr3.kinematics import LegKinematics
-from rpr3gen_derive.rpr3.symbols import LEGS
+from rpr3gen_derive.planar import outputs, paper, structures
+from rpr3gen_derive.planar import symbols as syms
+from rpr3gen_derive.planar.calculus import at_zero, depends_on, differentiate
+from rpr3gen_derive.planar.derivation import algorithm
+from rpr3gen_derive.planar.dynamics import Inertia
+from rpr3gen_derive.planar.geometry import LEGS, Robot
+from rpr3gen_derive.planar.kinematics import LegKinematics
+from rpr3gen_derive.planar.structures import Structure
+from rpr3gen_derive.planar.vectors import along, rotate
 
 STEP_REGRESSOR = "regressor: efforts differentiated by the inertial parameters, eqs. (10)-(17)"
 STEP_PAYLOAD = "efforts holding the payload at rest (inertial parameters zero), eqs. (12)-(17)"
 
 #: The four inertial parameters of a body, in order.
 QUANTITIES: tuple[str, ...] = ("m", "mcx", "mcy", "Jzz")
-#: Moving bodies: cylinder (1) and piston (2) of each leg, leg by leg, then the platform (3).
+#: Moving bodies: bodies 1 and 2 of each leg, leg by leg, then the platform (3).
 BODIES: tuple[str, ...] = (*(f"{k}{leg}" for leg in LEGS for k in "12"), "3")
-#: Bodies when the three legs share one set of parameters (``identical_legs``).
-SHARED_BODIES: tuple[str, ...] = ("1", "2", "3")
 
 INERTIAL_PARAMETER_NAMES: tuple[str, ...] = tuple(f"{q}_{b}" for b in BODIES for q in QUANTITIES)
+
+#: Bodies when the three legs share one set of parameters (``identical_legs``).
+SHARED_BODIES: tuple[str, ...] = ("1", "2", "3")
 SHARED_PARAMETER_NAMES: tuple[str, ...] = tuple(
     f"{q}_{b}" for b in SHARED_BODIES for q in QUANTITIES
 )
@@ -84,111 +72,42 @@ def _body(name: str) -> tuple[sp.Symbol, sp.Symbol, sp.Symbol, sp.Symbol]:
     return m, mcx, mcy, jzz
 
 
-# ----------------------------------------------------------------------------------------------
-# The required wrenches (10)-(11) with symbolic inertial parameters.
+def symbolic_leg_inertias(kin: LegKinematics) -> tuple[Inertia, Inertia]:
+    """Bodies 1 and 2 of a leg about their first joint points, with symbolic inertial
+    parameters: the first moment ``mcx f + mcy perp(f)``, ``f`` the current x axis of the body's
+    frame of inertial parameters (leg frame)."""
+    out = []
+    for body in (1, 2):
+        m, mcx, mcy, jzz = _body(f"{body}{kin.leg}")
+        axis = kin.body_vector(body, kin.geometry.inertial_x[body - 1])
+        out.append(Inertia(m, along((mcx, mcy), axis), jzz))
+    return out[0], out[1]
 
 
-def _linear(vector: sp.Matrix) -> sp.Matrix:
-    """Expand a wrench whose centre of mass was given as ``m c / m``; check it is linear."""
-    out = vector.applyfunc(sp.expand)
-    names = set(pi_symbols.values())
-    for term in (t for entry in out for t in sp.Add.make_args(entry)):
-        numerator, denominator = sp.fraction(term)
-        if denominator.free_symbols & names:
-            raise RuntimeError("a required wrench divides by an inertial parameter")
-        if len([f for f in sp.Mul.make_args(numerator) if f.free_symbols & names]) > 1:
-            raise RuntimeError("a required wrench is not linear in the inertial parameters")
-    return out
-
-
-def body_wrench(
-    motion: BodyMotion,
-    mass: sp.Expr,
-    first_moment: sp.Matrix,
-    inertia_zz: sp.Expr,
-    axis: int,
-    gravity: sp.Matrix,
-) -> tuple[sp.Matrix, sp.Matrix]:
-    """``F_k0``, ``M_k0`` of ``dynamics.required_wrench`` (eqs. 10-11, no external load) as
-    linear forms in ``(m, m c, J)``, all about the joint point and in the body frame.
-
-    ``required_wrench`` takes the centre of mass ``c``; it is given ``m c / m`` and the result is
-    expanded, which cancels ``m`` exactly (the wrench contains ``c`` only as ``m c``). ``axis``
-    is the body-frame axis normal to the plane (2 = z for frames 1 and 3, 0 = x2 = -z0).
-    """
-    inertia = sp.zeros(3, 3)
-    inertia[axis, axis] = inertia_zz
-    F, M = required_wrench(motion, mass, first_moment / mass, inertia, gravity)
-    return _linear(F), _linear(M)
-
-
-def identification_wrenches(
-    prog: Program, kin: LegKinematics, carries_platform: bool
-) -> tuple[LegWrenches, tuple[sp.Matrix, sp.Matrix]]:
-    """``F_k``, ``M_k`` of eqs. (10)-(11) of one leg with the inertial parameters as symbols.
-
-    As ``dynamics.leg_wrenches``, with, in the body frames: the cylinder's first moment about
-    A1 ``(mcx, mcy, 0)`` in frame 1 (x1 = e, y1 = n); the piston's about A2 ``(0, mcy, mcx)``
-    in frame 2 (y2 = n, z2 = e); the platform's about A3 ``m rho + (mcx, mcy, 0)`` in frame 3
-    (parallel to the platform frame; ``rho = G - A3``), with ``J_A3 = Jzz + m |rho|^2 +
-    2 rho . (mcx, mcy)``. The payload acts at G, separately (it does not scale with pi); its
-    part of ``F_3``, ``M_3`` is returned too (zero unless ``carries_platform``).
-    """
-    leg = kin.leg
-    cyl, piston, platform = body_motions(kin)
-    g1 = kin.a10 * syms.gravity
-    g2 = kin.a21 * g1
-    g3 = kin.a30 * syms.gravity
-    m, mcx, mcy, jzz = _body(f"1{leg}")
-    F10, M10 = body_wrench(cyl, m, sp.Matrix([mcx, mcy, 0]), jzz, 2, g1)
-    m, mcx, mcy, jzz = _body(f"2{leg}")
-    F20, M20 = body_wrench(piston, m, sp.Matrix([0, mcy, mcx]), jzz, 0, g2)
-    step = STEP_INERTIA
-    F10 = prog.define_vector(f"F10pi_{leg}", F10, step)
-    M10 = prog.define_vector(f"M10pi_{leg}", M10, step)
-    F20 = prog.define_vector(f"F20pi_{leg}", F20, step)
-    M20 = prog.define_vector(f"M20pi_{leg}", M20, step)
-    payload = (sp.zeros(3, 1), sp.zeros(3, 1))
-    if carries_platform:
-        m, mcx, mcy, jzz = _body("3")
-        rho = kin.rho
-        first = m * rho + sp.Matrix([mcx, mcy, 0])
-        about_a3 = jzz + m * (rho.T * rho)[0] + 2 * (rho[0] * mcx + rho[1] * mcy)
-        F30, M30 = body_wrench(platform, m, first, about_a3, 2, g3)
-        # The payload wrench at G (body "mass" zero, its point of application rho from A3).
-        Fp, Mp = required_wrench(
-            platform,
-            sp.Integer(0),
-            rho,
-            sp.zeros(3, 3),
-            g3,
-            external_force=kin.a30 * syms.payload_force,
-            external_moment=syms.payload_moment,
-        )
-        payload = (Fp, Mp)
-        F3 = prog.define_vector(f"F3pi_{leg}", F30 + Fp, step)
-        M3 = prog.define_vector(f"M3pi_{leg}", M30 + Mp, step)
-    else:
-        F3, M3 = sp.zeros(3, 1), sp.zeros(3, 1)
-    step = STEP_RECURSION
-    r21 = (syms.l0 + kin.lambda21) * u1
-    r32 = syms.l2 * u3
-    F2 = prog.define_vector(f"F2pi_{leg}", F20 + kin.a32.T * F3, step)
-    M2 = prog.define_vector(f"M2pi_{leg}", M20 + kin.a32.T * M3 + skew(r32) * kin.a32.T * F3, step)
-    F1 = prog.define_vector(f"F1pi_{leg}", F10 + kin.a21.T * F2, step)
-    M1 = prog.define_vector(f"M1pi_{leg}", M10 + kin.a21.T * M2 + skew(r21) * kin.a21.T * F2, step)
-    return LegWrenches(F=(F1, F2, F3), M=(M1, M2, M3)), payload
+def symbolic_platform_inertia(robot: Robot, cos_phi: sp.Expr, sin_phi: sp.Expr) -> Inertia:
+    """The platform about G with symbolic inertial parameters (first moment in the platform
+    frame, turned by ``phi``)."""
+    m, mcx, mcy, jzz = _body("3")
+    return Inertia(m, rotate(cos_phi, sin_phi, (mcx, mcy)), jzz)
 
 
 @cache
-def _efforts_program(actuation: str) -> tuple[Program, tuple[sp.Expr, ...]]:
-    """The paper's algorithm (eqs. 5-17) with symbolic inertial parameters: the efforts."""
+def _efforts_program(structure: Structure) -> tuple[Program, tuple[sp.Expr, ...]]:
+    """The algorithm (eqs. 5-17) with symbolic inertial parameters: the efforts."""
     prog = Program()
-    _, loads = algorithm(
-        prog, actuation, lambda p, kin, platform: identification_wrenches(p, kin, platform)[0]
+    robot = structures.robot(structure)
+    _, _, loads = algorithm(
+        prog,
+        robot,
+        structure.actuated,
+        inertias=symbolic_leg_inertias,
+        platform_body=symbolic_platform_inertia,
     )
-    effort = ACTUATORS[actuation].effort
-    return prog, tuple(loads[f"{effort}_{leg}"] for leg in LEGS)
+    values = {}
+    for leg in LEGS:
+        joint = loads.joints[(leg, structure.actuated)]
+        values[leg] = joint.moment if structure.actuated_kind == "R" else joint.force[0]
+    return prog, tuple(values[leg] for leg in LEGS)
 
 
 def _merge(prog: Program, source: Program, suffix: str) -> dict[sp.Symbol, sp.Expr]:
@@ -214,50 +133,51 @@ def _merge(prog: Program, source: Program, suffix: str) -> dict[sp.Symbol, sp.Ex
     return rename
 
 
-def efforts(prog: Program, actuation: str) -> list[sp.Expr]:
+def efforts(prog: Program, structure: Structure) -> list[sp.Expr]:
     """The actuator efforts with symbolic inertial parameters, appended to ``prog``.
 
     Assignments already in ``prog`` with the same right-hand side are shared (the leg
     kinematics of eqs. 5-9); those defined differently there (the loads of eqs. 12-17 of the
     model's own derivation) get the suffix ``__pi``.
     """
-    source, outputs = _efforts_program(actuation)
+    source, values = _efforts_program(structure)
     rename = _merge(prog, source, "__pi")
-    return [sp.sympify(e).xreplace(rename) for e in outputs]
+    return [sp.sympify(e).xreplace(rename) for e in values]
 
 
-def regressor(prog: Program, actuation: str) -> sp.Matrix:
+def regressor(prog: Program, structure: Structure) -> sp.Matrix:
     """``Y`` (3 x 28): ``tau = Y @ pi + tau_payload``, tau the efforts of legs A, B, C.
 
     Column j is ``d tau / d pi_j`` (:data:`INERTIAL_PARAMETER_NAMES`), differentiated through
     the program of eqs. (5)-(17) (:func:`efforts`); the efforts being linear in pi (checked), Y
     depends on the pose, velocity and acceleration and on the geometry and gravity only.
     """
-    taus = efforts(prog, actuation)
+    taus = efforts(prog, structure)
     symbols = [pi_symbols[n] for n in INERTIAL_PARAMETER_NAMES]
-    table = differentiate(prog, taus, symbols, STEP_REGRESSOR)
-    Y = sp.Matrix(table)
+    Y = sp.Matrix(differentiate(prog, taus, symbols, STEP_REGRESSOR))
     for entry in Y:
         if depends_on(prog, entry, symbols):
             raise RuntimeError("the actuator efforts are not linear in the inertial parameters")
     return Y
 
 
-def payload_efforts(prog: Program, actuation: str) -> sp.Matrix:
-    """``tau_payload`` (3): the efforts at ``pi = 0``, which hold the payload wrench (fx, fy,
-    mz at G) at rest, eqs. (12)-(17) with only the payload in ``F_3``, ``M_3``.
-
-    Without mass nothing depends on the velocity or the acceleration (the payload wrench is
-    given, the virtual velocities are geometric), so they are set to zero too: the result is a
-    function of the pose (and the geometry and payload) alone.
-    """
-    taus = efforts(prog, actuation)
+def payload_efforts(prog: Program, structure: Structure) -> sp.Matrix:
+    """``tau_payload`` (3): the efforts at ``pi = 0``, which hold the payload wrench (at G) at
+    rest: without mass nothing depends on the velocity or the acceleration (the payload wrench
+    is given, the virtual velocities are geometric), so the result is a function of the pose
+    (and the geometry and payload) alone."""
+    taus = efforts(prog, structure)
     symbols = [pi_symbols[n] for n in INERTIAL_PARAMETER_NAMES] + [*syms.qd, *syms.qdd]
     return sp.Matrix(at_zero(prog, taus, symbols, "_pi0", STEP_PAYLOAD))
 
 
+def effort_family(structure: Structure) -> str:
+    """The name of the actuator efforts' family (``tau``; the paper's ``m10``, ``f21z``)."""
+    return outputs.effort_family(structure)
+
+
 # ----------------------------------------------------------------------------------------------
-# Numeric values and identical legs.
+# The paper's robot: numeric values, identical legs, base parameters in closed form.
 
 
 def inertial_parameters(params: Mapping[str, float], identical_legs: bool = False) -> np.ndarray:
@@ -415,10 +335,11 @@ def regroupings(identical_legs: bool = False) -> dict[str, sp.Expr]:
     for leg in legs:
         out[f"mcx_1{leg}"] = s[f"mcx_1{leg}"]
         out[f"mcy_1{leg}"] = s[f"mcy_1{leg}"]
-        out[f"Jzz_1{leg}"] = s[f"Jzz_1{leg}"] + s[f"Jzz_2{leg}"] - syms.l2**2 * s[f"m_2{leg}"]
-        out[f"mcx_2{leg}"] = s[f"mcx_2{leg}"] - syms.l2 * s[f"m_2{leg}"]
+        l2 = paper.params["l2"]
+        out[f"Jzz_1{leg}"] = s[f"Jzz_1{leg}"] + s[f"Jzz_2{leg}"] - l2**2 * s[f"m_2{leg}"]
+        out[f"mcx_2{leg}"] = s[f"mcx_2{leg}"] - paper.params["l2"] * s[f"m_2{leg}"]
         out[f"mcy_2{leg}"] = s[f"mcy_2{leg}"]
-    joints = [syms.platform_joint(leg) for leg in LEGS]
+    joints = [paper.platform_joint(leg) for leg in LEGS]
     masses = [s["m_2"]] * 3 if identical_legs else [s[f"m_2{leg}"] for leg in LEGS]
     out["m_3"] = s["m_3"] + sum(masses)
     out["mcx_3"] = s["mcx_3"] + sum(p[0] * m for p, m in zip(joints, masses, strict=True))
@@ -433,7 +354,7 @@ def regroupings(identical_legs: bool = False) -> dict[str, sp.Expr]:
 def regrouping_matrix(params: Mapping[str, float], identical_legs: bool = False) -> np.ndarray:
     """:func:`regroupings` as a numeric (B x P) matrix for a model's geometry."""
     names = parameter_names(identical_legs)
-    values = {syms.params[k]: float(v) for k, v in params.items() if k in syms.params}
+    values = {paper.params[k]: float(v) for k, v in params.items() if k in paper.params}
     rows = []
     for expr in regroupings(identical_legs).values():
         expr = sp.expand(expr.xreplace(values))

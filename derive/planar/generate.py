@@ -1,0 +1,70 @@
+"""Generate code: every module of the registry through the engine.
+
+``rpr3gen generate`` calls :func:`render` and writes its files with
+:func:`~rpr3gen_derive.codegen.files.write_files` (or compares them, ``--check``). The committed
+variants (:data:`COMMITTED`) live in the repository's ``generated/``; any other structure is
+generated on demand (``rpr3gen generate --leg RRR --actuated 2``, or by the runtime into its
+cache on first use).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping
+from pathlib import Path
+
+from rpr3gen_derive.codegen.render import Generator, Stage, no_stage
+from rpr3gen_derive.planar.registry import FunctionBuilder, module
+from rpr3gen_derive.planar.structures import PAPER, Structure
+
+ROBOT_DIR = Path(__file__).resolve().parent
+
+#: The variants committed in ``generated/``: the paper's two and the 3-RRR with base motors.
+COMMITTED: tuple[Structure, ...] = (*PAPER, Structure("RRR", 1))
+
+PACKAGE_DOC = """Generated code of rpr3gen, one folder per variant (a leg type, its actuated joint).
+
+Each folder holds ``rpr3_numpy.py`` (needs only numpy), the C99 sources ``rpr3.h`` and
+``rpr3.c`` (need only ``<math.h>`` and ``<stddef.h>``) and ``manifest.json``, which lists every
+function's signature, name tables, thresholds and return codes for the runtime.
+"""
+
+
+def generator(stage: Stage = no_stage) -> Generator:
+    """The engine, set up for this derivation's sources."""
+    return Generator(
+        hash_roots=(ROBOT_DIR,),
+        package_doc=PACKAGE_DOC,
+        stage=stage,
+        template_dirs=(ROBOT_DIR / "templates",),
+    )
+
+
+def render(
+    structures: Iterable[Structure] = COMMITTED,
+    functions: Mapping[str, FunctionBuilder] | None = None,
+    stage: Stage = no_stage,
+    package: Iterable[Structure] | None = None,
+) -> dict[str, str]:
+    """Every generated file for ``structures``, ``{relative path: text}``.
+
+    ``package``: the variants the folder's ``__init__.py`` lists (default: ``structures``).
+    """
+    gen = generator(stage)
+    structures = tuple(structures)
+    modules = []
+    for structure in structures:
+        with stage(f"variant:{structure.variant}"), stage("derive"):
+            modules.append(module(structure, functions))
+    listed = structures if package is None else tuple(package)
+    return gen.render(modules, variants=tuple(s.variant for s in listed))
+
+
+def source_hash() -> str:
+    """The hash the generated files carry: of the engine's and this derivation's sources."""
+    return generator().source_hash()
+
+
+def default_out_dir() -> Path | None:
+    """``generated/`` beside ``derive/`` in a source checkout, or None when there is none."""
+    out = ROBOT_DIR.parent.parent / "generated"
+    return out if (out / "__init__.py").is_file() else None
