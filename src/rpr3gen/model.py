@@ -27,7 +27,9 @@ from typing import Any, NoReturn
 import numpy as np
 
 from rpr3gen import manifest
-from rpr3gen.errors import ModelError, Rpr3genError, did_you_mean
+from rpr3gen.errors import ModelError, did_you_mean
+from rpr3gen.model_checks import check_fields
+from rpr3gen.validation import Optional, PathArg, checked
 
 __all__ = [
     "ACTUATIONS",
@@ -128,28 +130,10 @@ class Model:
     generated: str | None = None
 
     def __post_init__(self) -> None:
-        if self.actuation not in ACTUATIONS:
-            raise ModelError(
-                f"{self.source}: actuation: must be one of {_quoted(ACTUATIONS)}, "
-                f"got {_describe(self.actuation)}"
-            )
-        if set(self.params) != set(PARAM_NAMES):
-            missing = [n for n in PARAM_NAMES if n not in self.params]
-            extra = sorted(set(self.params) - set(PARAM_NAMES))
-            raise ModelError(f"{self.source}: params: missing {missing}, unexpected {extra}")
-        ordered = _ReadOnlyParams({n: float(self.params[n]) for n in PARAM_NAMES})
-        object.__setattr__(self, "params", ordered)
-        if self.generated is not None:
-            object.__setattr__(self, "generated", os.fspath(self.generated))
-            try:
-                variant = manifest.load(self.actuation, self.generated)
-            except Rpr3genError as exc:
-                raise ModelError(f"generated code: {exc}") from None
-            if variant.param_names != PARAM_NAMES:
-                raise ModelError(
-                    f"{variant.folder}: generated for other model parameters than this "
-                    "runtime's; regenerate it with this version"
-                )
+        fields = check_fields(self, ACTUATIONS, PARAM_NAMES)  # rpr3gen.model_checks
+        object.__setattr__(self, "params", _ReadOnlyParams(fields["params"]))
+        object.__setattr__(self, "stroke", fields["stroke"])
+        object.__setattr__(self, "generated", fields["generated"])
 
     def vector(self, names: Sequence[str] = PARAM_NAMES) -> np.ndarray:
         """Return the parameters ``names`` as a new float64 array of shape ``(len(names),)``.
@@ -160,6 +144,7 @@ class Model:
         return np.array([self.params[n] for n in names], dtype=np.float64)
 
 
+@checked(path=Optional(PathArg()), generated=Optional(PathArg()))
 def load_model(
     path: str | os.PathLike[str] | None = None,
     generated: str | os.PathLike[str] | None = None,
