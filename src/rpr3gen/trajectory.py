@@ -23,9 +23,11 @@ from typing import TextIO
 
 import numpy as np
 
+from rpr3gen import sizes
 from rpr3gen.atomic import write_csv_table
 from rpr3gen.derivatives import check_smoothing, differentiate, mismatch
-from rpr3gen.errors import InputTypeError, TrajectoryError, TrajectoryWarning, did_you_mean
+from rpr3gen.errors import TrajectoryError, TrajectoryWarning, did_you_mean
+from rpr3gen.validation import Instance, Integer, Number, Optional, PathArg, checked, numbers
 
 __all__ = [
     "CSV_COLUMNS",
@@ -77,17 +79,23 @@ class Trajectory:
     qdd: np.ndarray
 
     def __post_init__(self) -> None:
-        t = np.array(self.t, dtype=np.float64)
+        t = np.array(numbers("t", self.t))  # InputTypeError for what is not numbers
         if t.ndim != 1 or t.size == 0:
             raise TrajectoryError(f"trajectory: t must have shape (n,) with n >= 1, got {t.shape}")
         for name in ("t", "q", "qd", "qdd"):
-            value = t if name == "t" else np.array(getattr(self, name), dtype=np.float64)
+            value = t if name == "t" else np.array(numbers(name, getattr(self, name)))
             if name != "t" and value.shape != (t.size, 3):
                 raise TrajectoryError(
                     f"trajectory: {name} must have shape ({t.size}, 3), got {value.shape}"
                 )
             value.setflags(write=False)
             object.__setattr__(self, name, value)
+        if not np.isfinite(t).all() or (np.diff(t) <= 0).any():
+            k = int(np.flatnonzero(~np.isfinite(t) | np.r_[False, np.diff(t) <= 0])[0])
+            raise TrajectoryError(
+                f"trajectory: t must be finite and strictly increasing, got t[{k}] = {t[k]:g}"
+                + (f" after {t[k - 1]:g}" if k else "")
+            )
 
     def __len__(self) -> int:
         """Number of samples."""
@@ -124,6 +132,12 @@ class Trajectory:
         return cls(t=given.t, q=q_fit, qd=qd, qdd=qdd)
 
 
+@checked(
+    name=Instance(str, "'rotation' or 'rectilinear'"),
+    samples=Integer(2, cost=lambda n: n * sizes.PAPER_SAMPLE, what="the trajectory",
+                    error=TrajectoryError),
+    duration=Number(greater=0.0, unit="s", error=TrajectoryError),
+)  # fmt: skip
 def paper_trajectory(
     name: str, samples: int = DEFAULT_SAMPLES, duration: float = DEFAULT_DURATION
 ) -> Trajectory:
@@ -145,17 +159,9 @@ def paper_trajectory(
     if name not in PAPER_TRAJECTORIES:
         hint = did_you_mean(str(name), PAPER_TRAJECTORIES)
         choices = " or ".join(PAPER_TRAJECTORIES)
-        raise TrajectoryError(f"unknown trajectory {name!r}: choose {choices}{hint}")
-    if isinstance(samples, bool) or not isinstance(samples, int | np.integer):
-        raise InputTypeError(f"samples: must be an integer >= 2, got {samples!r}")
-    if samples < 2:
-        raise TrajectoryError(f"samples: must be an integer >= 2, got {samples!r}")
-    if isinstance(duration, bool) or not isinstance(
-        duration, int | float | np.integer | np.floating
-    ):
-        raise InputTypeError(f"duration: must be a finite number of seconds > 0, got {duration!r}")
-    if not math.isfinite(duration) or duration <= 0:
-        raise TrajectoryError(f"duration: must be a finite number of seconds > 0, got {duration!r}")
+        raise TrajectoryError(
+            f"name: unknown trajectory {name!r}: choose {choices}{hint}", argument="name"
+        )
 
     amplitude = np.array(PAPER_TRAJECTORIES[name], dtype=np.float64)
     t = np.linspace(0.0, float(duration), int(samples))
@@ -171,6 +177,7 @@ def paper_trajectory(
     )
 
 
+@checked(path=PathArg(), smoothing=Optional(Number(least=0.0)))
 def read_trajectory_csv(
     path: str | os.PathLike[str], *, smoothing: float | None = None
 ) -> Trajectory:

@@ -22,18 +22,22 @@ from typing import Any
 
 import numpy as np
 
-from rpr3gen import manifest
+from rpr3gen import manifest, sizes
+from rpr3gen.backends import BLOCK
 from rpr3gen.design.cluster import run_chunks
 from rpr3gen.design.grid import read_grid
 from rpr3gen.design.metrics import SweepPlan, evaluate_chunk
 from rpr3gen.errors import (
+    GridError,
     InputError,
     InputTypeError,
     Rpr3genError,
     TrajectoryError,
     did_you_mean,
 )
+from rpr3gen.evaluators import all_cores
 from rpr3gen.model import ACTUATIONS, model_from_dict, read_model_data
+from rpr3gen.paths import check_output
 from rpr3gen.policy import DEFAULT_MIN_CONDITIONING
 from rpr3gen.trajectory import (
     DEFAULT_DURATION,
@@ -42,11 +46,23 @@ from rpr3gen.trajectory import (
     Trajectory,
     paper_trajectory,
 )
+from rpr3gen.validation import (
+    Check,
+    Flag,
+    Instance,
+    Integer,
+    Number,
+    Optional,
+    PathArg,
+    checked,
+    describe,
+)
 
 __all__ = [
     "DEFAULT_AREA_RESOLUTION",
     "DEFAULT_CHUNK_SIZE",
     "DEFAULT_TRAJECTORIES",
+    "SweepInterrupted",
     "parts_folder",
     "sweep",
 ]
@@ -66,11 +82,82 @@ _FORMAT = 1
 Columns = dict[str, Any]
 
 
+class SweepInterrupted(KeyboardInterrupt):
+    """Ctrl-C during a sweep that writes a file: how many chunks are done and kept, and where.
+
+    Attributes:
+        kept: chunks done, in ``folder``.
+        chunks: chunks of the sweep.
+        folder: the parts folder, which ``resume=True`` continues from.
+    """
+
+    def __init__(self, kept: int, chunks: int, folder: Path) -> None:
+        super().__init__(
+            f"{kept} of {chunks} chunks done, kept in {folder}: resume=True computes only the "
+            "others"
+        )
+        self.kept, self.chunks, self.folder = kept, chunks, folder
+
+
 def parts_folder(out: str | os.PathLike[str]) -> Path:
     """Where a sweep writing ``out`` keeps its finished chunks: ``out`` + ``.parts``."""
     return Path(f"{os.fspath(out)}.parts")
 
 
+class _OneOf(Check):
+    """A path, or a mapping (the parsed TOML), or None when ``optional``."""
+
+    def __init__(self, what: str, *, optional: bool) -> None:
+        self.what, self.optional = what, optional
+
+    def __call__(self, name: str, value: Any) -> Any:
+        if (value is None and self.optional) or isinstance(value, Mapping):
+            return value
+        if isinstance(value, str | os.PathLike):
+            return PathArg()(name, value)
+        raise InputTypeError(f"{name}: must be {self.what}, got {describe(value)}", argument=name)
+
+
+class _Trajectories(Check):
+    """A non-empty list of ``"rotation"``, ``"rectilinear"``, CSV files or Trajectory objects."""
+
+    def __call__(self, name: str, value: Any) -> tuple[Any, ...]:
+        what = "a list of trajectories ('rotation', 'rectilinear', CSV files, Trajectory objects)"
+        if isinstance(value, str | os.PathLike | Trajectory) or not isinstance(value, Sequence):
+            raise InputTypeError(f"{name}: must be {what}, got {describe(value)}", argument=name)
+        if not value:
+            raise InputError(f"{name}: give at least one trajectory", argument=name)
+        for i, item in enumerate(value):
+            if not isinstance(item, str | os.PathLike | Trajectory):
+                raise InputTypeError(
+                    f"{name}[{i}]: must be 'rotation', 'rectilinear', a CSV file or a Trajectory, "
+                    f"got {describe(item)}",
+                    argument=name,
+                )
+        return tuple(value)
+
+
+_CHECKS: dict[str, Check] = {
+    "chunk_size": Integer(1),
+    "area_resolution": Integer(0),
+    "samples": Integer(2),
+    "duration": Number(greater=0.0, unit="s"),
+}
+
+
+@checked(
+    model=_OneOf("a model file, its tables as a mapping, or None", optional=True),
+    grid=_OneOf("a grid file or a mapping {dotted model key: values}", optional=False),
+    trajectories=_Trajectories(),
+    out=Optional(PathArg()),
+    scheduler=Optional(Instance(str, "a scheduler address such as 'tcp://host:8786'")),
+    workers=Optional(Integer(0)),
+    resume=Flag(),
+    chunk_size=_CHECKS["chunk_size"],
+    area_resolution=_CHECKS["area_resolution"],
+    samples=_CHECKS["samples"],
+    duration=_CHECKS["duration"],
+)
 def sweep(
     model: str | os.PathLike[str] | Mapping[str, Any] | None = None,
     grid: str | os.PathLike[str] | Mapping[str, Any] | None = None,
@@ -117,21 +204,24 @@ def sweep(
         Rpr3genError: an interrupted sweep's chunks are in the way (without ``resume``), or
             they belong to another sweep.
     """
+    if out is None and resume:
+        raise InputError("resume: needs out, the file whose chunks are resumed", argument="resume")
+    if out is not None:
+        target = check_output(out, "the sweep", argument="out")
+        check_output(parts_folder(target), "the sweep's parts", folder=True, argument="out")
+    local = scheduler is None and workers != 0
+    processes = (workers or all_cores()) if local else 1 if scheduler is None else 0
     plan = make_plan(model, grid, trajectories, chunk_size=chunk_size,
                      min_conditioning=min_conditioning, area_resolution=area_resolution,
-                     samples=samples, duration=duration)  # fmt: skip
-    _check_workers(workers)
+                     samples=samples, duration=duration, processes=processes,
+                     workers=workers)  # fmt: skip
     if out is None:
-        if resume:
-            raise InputError("resume: needs out, the file whose chunks are resumed")
         parts: dict[int, Columns] = {}
         run_chunks(plan, range(plan.chunks), evaluate_chunk, parts.__setitem__, scheduler, workers,
                    progress)  # fmt: skip
         return _joined(_table(parts[i]) for i in range(plan.chunks))
     from rpr3gen.design import parquet
 
-    target = Path(out)
-    _check_destination(target)
     folder = _open_parts(plan, parts_folder(target), resume)
 
     def keep(index: int, columns: Columns) -> None:
@@ -144,6 +234,8 @@ def sweep(
         run_chunks(plan, todo, evaluate_chunk, keep, scheduler, workers, progress, initial=initial)
     except Rpr3genError as exc:
         raise Rpr3genError(f"{exc}; the chunks done are in {folder}: rerun with --resume") from exc
+    except KeyboardInterrupt as exc:
+        raise SweepInterrupted(len(_done_chunks(plan, folder)), plan.chunks, folder) from exc
     target.parent.mkdir(parents=True, exist_ok=True)
     parquet.write_tables(target, (folder / _part_name(i) for i in range(plan.chunks)))
     shutil.rmtree(folder)
@@ -160,14 +252,26 @@ def make_plan(
     area_resolution: int = DEFAULT_AREA_RESOLUTION,
     samples: int = DEFAULT_SAMPLES,
     duration: float = DEFAULT_DURATION,
+    processes: int = 1,
+    workers: int | None = None,
 ) -> SweepPlan:
-    """Check every input and build the :class:`SweepPlan` (no work yet)."""
+    """Check every input and build the :class:`SweepPlan` (no work yet).
+
+    ``processes``: how many tasks run at once on this machine (local workers, or 1 in this
+    process, 0 on a remote cluster), for the memory check (:func:`_check_memory`); ``workers``:
+    the argument that set them, to name in its message (None: one per core).
+    """
     if grid is None:
-        raise InputError("grid: give a grid file or a mapping {dotted model key: values}")
-    _positive_int("chunk_size", chunk_size, least=1)
-    _positive_int("area_resolution", area_resolution, least=0)
+        raise InputTypeError("grid: give a grid file or a mapping {dotted model key: values}",
+                             argument="grid")  # fmt: skip
+    for name, value in (("chunk_size", chunk_size), ("area_resolution", area_resolution),
+                        ("samples", samples), ("duration", duration)):  # fmt: skip
+        _CHECKS[name](name, value)
     if area_resolution == 1:
-        raise InputError("area_resolution: must be 0 (no area) or an integer >= 2, got 1")
+        raise InputError(
+            "area_resolution: must be 0 (no area) or an integer >= 2, got 1",
+            argument="area_resolution",
+        )
     if not 0.0 <= min_conditioning < 1.0:
         raise InputError(f"min_conditioning: must be in [0, 1), got {min_conditioning!r}")
     if isinstance(model, Mapping):
@@ -176,7 +280,12 @@ def make_plan(
         source, base = read_model_data(model)
     model_from_dict(base, source=source)  # the base itself must be valid
     checked = read_grid(grid, base)
+    papers = sum(isinstance(t, str) and t in PAPER_TRAJECTORIES for t in trajectories)
+    sizes.check("samples", samples, lambda n: _sweep_cost(1, 1, papers * n, 0, 1),
+                "the paper trajectories' evaluation", least=2, argument="samples")  # fmt: skip
     names, trajs = _trajectories(trajectories, samples, duration)
+    _check_memory(checked, sum(len(t) for t in trajs), chunk_size, area_resolution, processes,
+                  workers)  # fmt: skip
     return SweepPlan(
         base=base,
         base_source=source,
@@ -189,16 +298,27 @@ def make_plan(
     )
 
 
-def _positive_int(name: str, value: Any, least: int) -> None:
-    if isinstance(value, bool) or not isinstance(value, int | np.integer):
-        raise InputTypeError(f"{name}: must be an integer >= {least}, got {value!r}")
-    if value < least:
-        raise InputError(f"{name}: must be an integer >= {least}, got {value!r}")
+def _sweep_cost(designs: int, chunk: int, samples: int, area: int, processes: int) -> int:
+    return sizes.sweep_cost(designs, min(chunk, designs), samples, area, processes, BLOCK)
 
 
-def _check_workers(workers: int | None) -> None:
-    if workers is not None:
-        _positive_int("workers", workers, least=0)
+def _check_memory(
+    grid: Any, samples: int, chunk: int, area: int, processes: int, workers: int | None
+) -> None:
+    """The sweep's sizes against the memory limit (:mod:`rpr3gen.sizes`), each with those
+    before it as given and those after it at their least: the area's resolution, the number of
+    designs, the worker processes."""
+    sizes.check("area_resolution", area, lambda a: _sweep_cost(1, 1, samples, a, 1),
+                "each design's workspace area", argument="area_resolution")  # fmt: skip
+    sizes.check(grid.source, len(grid), lambda d: _sweep_cost(d, chunk, samples, area, 1),
+                "the sweep's results and tasks", least=1, unit="designs",
+                error=GridError)  # fmt: skip
+    if processes > 1:
+        designs = len(grid)
+        sizes.check("workers" if workers else "workers (one per core)", processes,
+                    lambda w: _sweep_cost(designs, chunk, samples, area, w),
+                    "the local cluster's processes and their tasks", least=1,
+                    argument="workers")  # fmt: skip
 
 
 def _trajectories(
@@ -253,16 +373,6 @@ def identity(plan: SweepPlan) -> str:
     }
     text = json.dumps(described, sort_keys=True, default=str)
     return hashlib.sha256(text.encode()).hexdigest()
-
-
-def _check_destination(target: Path) -> None:
-    if target.is_dir():
-        raise Rpr3genError(f"{target}: cannot write the sweep: it is a folder")
-    for part in target.parents:
-        if part.exists():
-            if not part.is_dir():
-                raise Rpr3genError(f"{target}: cannot write the sweep: {part} is a file")
-            return
 
 
 def _open_parts(plan: SweepPlan, folder: Path, resume: bool) -> Path:
