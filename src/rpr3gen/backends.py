@@ -136,8 +136,9 @@ def evaluate(
             f"inputs: {function} takes {len(info.inputs)} ({names}), got {len(inputs)}",
             argument="inputs",
         )
-    arrays = [samples(arg.name, a, arg.size) for arg, a in zip(info.inputs, inputs, strict=True)]
-    check_same_length({arg.name: a for arg, a in zip(info.inputs, arrays, strict=True)})
+    arrays = [samples(f"inputs: {arg.name}", a, arg.size)
+              for arg, a in zip(info.inputs, inputs, strict=True)]  # fmt: skip
+    check_same_length({arg.name: a for arg, a in zip(info.inputs, arrays, strict=True)}, "inputs")
     first = info.inputs[0].name
     sizes.check(first, len(arrays[0]), lambda n: _evaluation_bytes(n, info),
                 f"the inputs and outputs of {function}", unit="samples")  # fmt: skip

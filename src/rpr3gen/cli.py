@@ -25,6 +25,7 @@ import numpy as np
 from rpr3gen import __version__, cli_identification, manifest, sizes
 from rpr3gen.backends import BACKENDS, OUTPUT_NAMES, inverse_dynamics
 from rpr3gen.cli_args import EXIT_ERROR, Parser, as_option, integer, number, subparser
+from rpr3gen.derivatives import MAX_SMOOTHING
 from rpr3gen.design.maps import DEFAULT_RESOLUTION, WorkspaceMap
 from rpr3gen.design.sweeps import (
     DEFAULT_AREA_RESOLUTION,
@@ -44,6 +45,7 @@ from rpr3gen.policy import DEFAULT_MIN_CONDITIONING, Invalid, invalid_samples
 from rpr3gen.trajectory import (
     DEFAULT_DURATION,
     DEFAULT_SAMPLES,
+    DURATIONS,
     PAPER_TRAJECTORIES,
     Trajectory,
     paper_trajectory,
@@ -94,13 +96,13 @@ def _parser() -> argparse.ArgumentParser:
     )
     sim.add_argument(
         "--duration",
-        type=number(greater=0.0, unit="s"),
+        type=number(least=DURATIONS[0], most=DURATIONS[1], unit="s"),
         metavar="T",
         help=f"duration of a paper trajectory, s (default: {DEFAULT_DURATION:g})",
     )
     sim.add_argument(
         "--smoothing",
-        type=number(least=0.0),
+        type=number(least=0.0, most=MAX_SMOOTHING),
         metavar="S",
         help="for a CSV file of positions only (t,x,y,phi): RMS deviation allowed between the "
         "quintic spline whose derivatives give the velocities and accelerations and the "
@@ -228,6 +230,7 @@ def _parser() -> argparse.ArgumentParser:
     sw.add_argument(
         "--trajectory",
         action="append",
+        dest="trajectories",
         metavar="NAME|FILE.csv",
         help="'rotation', 'rectilinear' or a trajectory CSV file; repeat for several "
         "(default: rotation and rectilinear)",
@@ -241,7 +244,7 @@ def _parser() -> argparse.ArgumentParser:
     )
     sw.add_argument(
         "--duration",
-        type=number(greater=0.0, unit="s"),
+        type=number(least=DURATIONS[0], most=DURATIONS[1], unit="s"),
         default=DEFAULT_DURATION,
         metavar="T",
         help=f"duration of each paper trajectory, s (default: {DEFAULT_DURATION:g})",
@@ -586,7 +589,7 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
         table = sweep(
             args.model,
             args.grid,
-            args.trajectory or DEFAULT_TRAJECTORIES,
+            args.trajectories or DEFAULT_TRAJECTORIES,
             out=args.out,
             scheduler=args.scheduler,
             workers=args.workers,
@@ -609,6 +612,8 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
 
 
 def _cmd_generate(args: argparse.Namespace) -> int:
+    if args.out and not args.check:  # before sympy loads: a second, not an hour of work
+        check_output(args.out, "the generated sources", folder=True, argument="out")
     try:
         from rpr3gen_derive.codegen import files as codegen_files
         from rpr3gen_derive.rpr3 import generate

@@ -16,6 +16,7 @@ import numpy as np
 
 from rpr3gen.atomic import atomic_write
 from rpr3gen.cli_args import integer, number
+from rpr3gen.derivatives import MAX_SMOOTHING
 from rpr3gen.model import LEGS, Model, load_model
 from rpr3gen.paths import check_output
 
@@ -48,7 +49,7 @@ def add_parsers(sub: argparse._SubParsersAction, paper_model: str) -> None:
     )
     ide.add_argument(
         "--smoothing",
-        type=number(least=0.0),
+        type=number(least=0.0, most=MAX_SMOOTHING),
         metavar="S",
         help="for a file of positions only: RMS deviation allowed to the smoothing spline "
         "(m, rad; default 0: through every sample; give the measurement noise)",

@@ -482,7 +482,8 @@ def identify(
         tau: (n, 3) the measured actuator efforts (``m10_*`` or ``f21z_*``).
         friction: also estimate viscous and Coulomb friction per actuator.
         identical_legs: the legs share one set of parameters (B = 9 instead of 19).
-        weights: (3,) the weight of each actuator's rows instead of the automatic ones.
+        weights: (3,) the weight of each actuator's rows instead of the automatic ones
+            (positive; only their ratios count).
         max_condition: the largest condition number accepted (default :data:`MAX_CONDITION`).
         t: (n,) the samples' times, only to name a bad sample in an error.
         backend: ``"numpy"`` or ``"c"`` for the generated regressor.
@@ -546,7 +547,8 @@ def identify(
         w = np.where(sigma > 0, 1.0 / np.where(sigma > 0, sigma, 1.0), 1.0)
         w = w / w.max()
     else:
-        w = np.asarray(weights)  # (3,), positive: checked
+        w = np.asarray(weights)  # (3,), positive and finite: checked
+        w = w / w.max()  # only their ratios count; so none overflows the weighted rows
     x, W, y = solve(w)
     weighted = y - W @ x
     sigma2 = float(weighted @ weighted) / (3 * n - p)

@@ -31,8 +31,11 @@ def check_fields(model: Any, actuations: Sequence[str], param_names: Sequence[st
         raise InputTypeError(f"source: must be a str, got {describe(model.source)}")
     if not isinstance(model.name, str):
         raise InputTypeError(f"{source}: name: must be a str, got {describe(model.name)}")
-    if not isinstance(model.actuation, str) or model.actuation not in actuations:
-        choices = " or ".join(f'"{a}"' for a in actuations)
+    choices = " or ".join(f'"{a}"' for a in actuations)
+    if not isinstance(model.actuation, str):
+        raise InputTypeError(f"{source}: actuation: must be {choices}, got "
+                             f"{describe(model.actuation)}")  # fmt: skip
+    if model.actuation not in actuations:
         raise ModelError(f"{source}: actuation: must be {choices}, got {describe(model.actuation)}")
     params = _params(model.params, source, param_names)
     stroke = None if model.stroke is None else _stroke(model.stroke, source)

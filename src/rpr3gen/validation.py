@@ -152,10 +152,14 @@ class Number(Check):
         self.least, self.most, self.greater, self.below = least, most, greater, below
 
     def expected(self) -> str:
-        bounded = self.least is not None and self.below is not None
+        low = self.least if self.least is not None else self.greater
+        high = self.most if self.most is not None else self.below
+        bounded = low is not None and high is not None
         parts = ["a finite number" if self.finite and not bounded else "a number"]
         if bounded:
-            parts.append(f"in [{self.least:g}, {self.below:g})")
+            left = "[" if self.least is not None else "("
+            right = "]" if self.most is not None else ")"
+            parts.append(f"in {left}{low:g}, {high:g}{right}")
         else:
             parts += [f"{op} {bound:g}" for op, bound in (
                 (">=", self.least), (">", self.greater), ("<=", self.most), ("<", self.below)
@@ -258,8 +262,9 @@ class PathArg(Check):
         return text
 
 
-def numbers(name: str, value: Any) -> np.ndarray:
-    """``value`` as a float64 array, or the error of a value that is not numbers."""
+def numbers(name: str, value: Any, error: type[Rpr3genError] = InputError) -> np.ndarray:
+    """``value`` as a float64 array, or the error of a value that is not numbers
+    (``InputTypeError``; ``error`` for a ragged sequence or a number beyond float64)."""
     expected = "an array of numbers"
     if value is None or isinstance(value, str | bytes | Mapping | set | frozenset):
         raise _type_error(name, expected, value)
@@ -268,9 +273,8 @@ def numbers(name: str, value: Any) -> np.ndarray:
     try:
         array = np.asarray(value)
     except ValueError:  # ragged nested sequences
-        raise _value_error(
-            name, "must be a regular array of numbers (rows of one length)"
-        ) from None
+        message = "must be a regular array of numbers (rows of one length)"
+        raise _value_error(name, message, error) from None
     except (TypeError, OverflowError, RecursionError):
         raise _type_error(name, expected, value) from None
     kind = array.dtype.kind
@@ -282,7 +286,7 @@ def numbers(name: str, value: Any) -> np.ndarray:
         try:
             return array.astype(np.float64)
         except OverflowError:
-            raise _value_error(name, "holds a number beyond float64's range") from None
+            raise _value_error(name, "holds a number beyond float64's range", error) from None
     raise InputTypeError(
         f"{name}: must be {expected}, got {describe(value)} holding {array.dtype} values",
         argument=name,
@@ -347,17 +351,20 @@ class Sample(Check):
         return np.ascontiguousarray(array)
 
 
-def check_same_length(arrays: Mapping[str, np.ndarray]) -> None:
+def check_same_length(arrays: Mapping[str, np.ndarray], label: str = "") -> None:
     """Refuse arrays (already checked) whose first dimensions differ, naming each with its
-    length: ``q, qd: must have the same number of samples, got q 2, qd 3``."""
+    length: ``q, qd: must have the same number of samples, got q 2, qd 3`` (after ``label:``,
+    the argument that holds them, when given)."""
     lengths = {name: len(a) for name, a in arrays.items() if a is not None}
     if len(set(lengths.values())) > 1:
         names = ", ".join(lengths)
         given = ", ".join(f"{name} {n}" for name, n in lengths.items())
         first = next(iter(lengths))
         odd = next(n for n in lengths if lengths[n] != lengths[first])
+        where = f"{label}: " if label else ""
         raise InputError(
-            f"{names}: must have the same number of samples, got {given}", argument=odd
+            f"{where}{names}: must have the same number of samples, got {given}",
+            argument=label or odd,
         )
 
 
@@ -392,10 +399,11 @@ def checked(*, same_length: Sequence[Sequence[str]] = (), **checks: Check) -> Ca
         names = [p.name for p in parameters[skip:]]
         if "model" in names and "model" not in checks and "model" not in COMMON:
             COMMON["model"] = IsModel()
-        table = {name: checks.get(name) or COMMON.get(name) for name in names}
-        missing = [name for name, check in table.items() if check is None]
+        found = {name: checks.get(name) or COMMON.get(name) for name in names}
+        missing = [name for name, check in found.items() if check is None]
         if missing:
             raise TypeError(f"{function.__qualname__}: no check for {', '.join(missing)}")
+        table: dict[str, Check] = {n: c for n, c in found.items() if c is not None}
         positional = [
             p.name
             for p in parameters[skip:]

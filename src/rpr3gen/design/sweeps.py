@@ -42,6 +42,7 @@ from rpr3gen.policy import DEFAULT_MIN_CONDITIONING
 from rpr3gen.trajectory import (
     DEFAULT_DURATION,
     DEFAULT_SAMPLES,
+    DURATIONS,
     PAPER_TRAJECTORIES,
     Trajectory,
     paper_trajectory,
@@ -123,15 +124,16 @@ class _Trajectories(Check):
 
     def __call__(self, name: str, value: Any) -> tuple[Any, ...]:
         what = "a list of trajectories ('rotation', 'rectilinear', CSV files, Trajectory objects)"
-        if isinstance(value, str | os.PathLike | Trajectory) or not isinstance(value, Sequence):
+        one = str | bytes | bytearray | os.PathLike | Trajectory  # not a list, though iterable
+        if isinstance(value, one) or not isinstance(value, Sequence):
             raise InputTypeError(f"{name}: must be {what}, got {describe(value)}", argument=name)
         if not value:
             raise InputError(f"{name}: give at least one trajectory", argument=name)
         for i, item in enumerate(value):
             if not isinstance(item, str | os.PathLike | Trajectory):
                 raise InputTypeError(
-                    f"{name}[{i}]: must be 'rotation', 'rectilinear', a CSV file or a Trajectory, "
-                    f"got {describe(item)}",
+                    f"{name}: item {i + 1} must be 'rotation', 'rectilinear', a CSV file or a "
+                    f"Trajectory, got {describe(item)}",
                     argument=name,
                 )
         return tuple(value)
@@ -141,7 +143,7 @@ _CHECKS: dict[str, Check] = {
     "chunk_size": Integer(1),
     "area_resolution": Integer(0),
     "samples": Integer(2),
-    "duration": Number(greater=0.0, unit="s"),
+    "duration": Number(least=DURATIONS[0], most=DURATIONS[1], unit="s"),
 }
 
 
@@ -341,8 +343,9 @@ def _trajectories(
             if path.suffix.lower() != ".csv" and not path.exists():
                 hint = did_you_mean(str(item), PAPER_TRAJECTORIES)
                 raise TrajectoryError(
-                    f"--trajectory: {os.fspath(item)!r} is neither "
-                    f"{', '.join(PAPER_TRAJECTORIES)} nor a CSV file{hint}"
+                    f"trajectories: {os.fspath(item)!r} is neither "
+                    f"{', '.join(PAPER_TRAJECTORIES)} nor a CSV file{hint}",
+                    argument="trajectories",
                 )
             names.append(path.stem)
             trajs.append(read_trajectory_csv(path))
