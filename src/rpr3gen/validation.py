@@ -277,6 +277,9 @@ def numbers(name: str, value: Any, error: type[Rpr3genError] = InputError) -> np
         raise _value_error(name, message, error) from None
     except (TypeError, OverflowError, RecursionError):
         raise _type_error(name, expected, value) from None
+    if array.dtype != np.float64 or not array.flags.c_contiguous:  # copied below, or later
+        sizes.check(name, array.size, lambda k: k * 8, "a float64 copy of it", unit="values",
+                    argument=name, error=error)  # fmt: skip
     kind = array.dtype.kind
     if kind in "iuf":
         return np.asarray(array, dtype=np.float64)
