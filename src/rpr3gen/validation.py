@@ -383,10 +383,17 @@ COMMON: dict[str, Check] = {
 use, to import :mod:`rpr3gen.model` late)."""
 
 
-def checked(*, same_length: Sequence[Sequence[str]] = (), **checks: Check) -> Callable[[F], F]:
+def checked(
+    table: Mapping[str, Check] | None = None,
+    /,
+    *,
+    same_length: Sequence[Sequence[str]] = (),
+    **checks: Check,
+) -> Callable[[F], F]:
     """Decorate a public function so that each argument given is checked by name first.
 
     Args:
+        table: checks by argument name, for a function with many (``**checks`` adds to it).
         same_length: groups of array arguments that must have as many samples (an
             argument not given, or None, is left out).
         **checks: the check of each argument not in :data:`COMMON` (or to override it).
@@ -394,6 +401,8 @@ def checked(*, same_length: Sequence[Sequence[str]] = (), **checks: Check) -> Ca
     Raises:
         TypeError: at decoration, when an argument has no check.
     """
+
+    checks = {**(table or {}), **checks}
 
     def decorate(function: F) -> F:
         signature = inspect.signature(function)

@@ -22,15 +22,18 @@ from typing import Any
 
 import numpy as np
 
-from rpr3gen import manifest, sizes
-from rpr3gen.backends import BLOCK
+from rpr3gen import manifest
 from rpr3gen.design.cluster import run_chunks
 from rpr3gen.design.grid import read_grid
 from rpr3gen.design.metrics import SweepPlan, evaluate_chunk
+from rpr3gen.design.sweep_checks import (
+    ARGUMENTS,
+    check_memory,
+    check_paper_samples,
+    check_values,
+)
 from rpr3gen.errors import (
-    GridError,
     InputError,
-    InputTypeError,
     Rpr3genError,
     TrajectoryError,
     did_you_mean,
@@ -42,21 +45,12 @@ from rpr3gen.policy import DEFAULT_MIN_CONDITIONING
 from rpr3gen.trajectory import (
     DEFAULT_DURATION,
     DEFAULT_SAMPLES,
-    DURATIONS,
     PAPER_TRAJECTORIES,
     Trajectory,
     paper_trajectory,
 )
 from rpr3gen.validation import (
-    Check,
-    Flag,
-    Instance,
-    Integer,
-    Number,
-    Optional,
-    PathArg,
     checked,
-    describe,
 )
 
 __all__ = [
@@ -105,61 +99,7 @@ def parts_folder(out: str | os.PathLike[str]) -> Path:
     return Path(f"{os.fspath(out)}.parts")
 
 
-class _OneOf(Check):
-    """A path, or a mapping (the parsed TOML), or None when ``optional``."""
-
-    def __init__(self, what: str, *, optional: bool) -> None:
-        self.what, self.optional = what, optional
-
-    def __call__(self, name: str, value: Any) -> Any:
-        if (value is None and self.optional) or isinstance(value, Mapping):
-            return value
-        if isinstance(value, str | os.PathLike):
-            return PathArg()(name, value)
-        raise InputTypeError(f"{name}: must be {self.what}, got {describe(value)}", argument=name)
-
-
-class _Trajectories(Check):
-    """A non-empty list of ``"rotation"``, ``"rectilinear"``, CSV files or Trajectory objects."""
-
-    def __call__(self, name: str, value: Any) -> tuple[Any, ...]:
-        what = "a list of trajectories ('rotation', 'rectilinear', CSV files, Trajectory objects)"
-        one = str | bytes | bytearray | os.PathLike | Trajectory  # not a list, though iterable
-        if isinstance(value, one) or not isinstance(value, Sequence):
-            raise InputTypeError(f"{name}: must be {what}, got {describe(value)}", argument=name)
-        if not value:
-            raise InputError(f"{name}: give at least one trajectory", argument=name)
-        for i, item in enumerate(value):
-            if not isinstance(item, str | os.PathLike | Trajectory):
-                raise InputTypeError(
-                    f"{name}: item {i + 1} must be 'rotation', 'rectilinear', a CSV file or a "
-                    f"Trajectory, got {describe(item)}",
-                    argument=name,
-                )
-        return tuple(value)
-
-
-_CHECKS: dict[str, Check] = {
-    "chunk_size": Integer(1),
-    "area_resolution": Integer(0),
-    "samples": Integer(2),
-    "duration": Number(least=DURATIONS[0], most=DURATIONS[1], unit="s"),
-}
-
-
-@checked(
-    model=_OneOf("a model file, its tables as a mapping, or None", optional=True),
-    grid=_OneOf("a grid file or a mapping {dotted model key: values}", optional=False),
-    trajectories=_Trajectories(),
-    out=Optional(PathArg()),
-    scheduler=Optional(Instance(str, "a scheduler address such as 'tcp://host:8786'")),
-    workers=Optional(Integer(0)),
-    resume=Flag(),
-    chunk_size=_CHECKS["chunk_size"],
-    area_resolution=_CHECKS["area_resolution"],
-    samples=_CHECKS["samples"],
-    duration=_CHECKS["duration"],
-)
+@checked(ARGUMENTS)
 def sweep(
     model: str | os.PathLike[str] | Mapping[str, Any] | None = None,
     grid: str | os.PathLike[str] | Mapping[str, Any] | None = None,
@@ -260,22 +200,12 @@ def make_plan(
     """Check every input and build the :class:`SweepPlan` (no work yet).
 
     ``processes``: how many tasks run at once on this machine (local workers, or 1 in this
-    process, 0 on a remote cluster), for the memory check (:func:`_check_memory`); ``workers``:
+    process, 0 on a remote cluster), for the memory check
+    (:func:`rpr3gen.design.sweep_checks.check_memory`); ``workers``:
     the argument that set them, to name in its message (None: one per core).
     """
-    if grid is None:
-        raise InputTypeError("grid: give a grid file or a mapping {dotted model key: values}",
-                             argument="grid")  # fmt: skip
-    for name, value in (("chunk_size", chunk_size), ("area_resolution", area_resolution),
-                        ("samples", samples), ("duration", duration)):  # fmt: skip
-        _CHECKS[name](name, value)
-    if area_resolution == 1:
-        raise InputError(
-            "area_resolution: must be 0 (no area) or an integer >= 2, got 1",
-            argument="area_resolution",
-        )
-    if not 0.0 <= min_conditioning < 1.0:
-        raise InputError(f"min_conditioning: must be in [0, 1), got {min_conditioning!r}")
+    check_values(grid, chunk_size, area_resolution, samples, duration, min_conditioning)
+    assert grid is not None  # checked
     if isinstance(model, Mapping):
         source, base = "<model>", dict(model)
     else:
@@ -283,11 +213,10 @@ def make_plan(
     model_from_dict(base, source=source)  # the base itself must be valid
     checked = read_grid(grid, base)
     papers = sum(isinstance(t, str) and t in PAPER_TRAJECTORIES for t in trajectories)
-    sizes.check("samples", samples, lambda n: _sweep_cost(1, 1, papers * n, 0, 1),
-                "the paper trajectories' evaluation", least=2, argument="samples")  # fmt: skip
+    check_paper_samples(samples, papers)
     names, trajs = _trajectories(trajectories, samples, duration)
-    _check_memory(checked, sum(len(t) for t in trajs), chunk_size, area_resolution, processes,
-                  workers)  # fmt: skip
+    check_memory(checked, sum(len(t) for t in trajs), chunk_size, area_resolution, processes,
+                 workers)  # fmt: skip
     return SweepPlan(
         base=base,
         base_source=source,
@@ -298,29 +227,6 @@ def make_plan(
         area_resolution=int(area_resolution),
         chunk_size=int(chunk_size),
     )
-
-
-def _sweep_cost(designs: int, chunk: int, samples: int, area: int, processes: int) -> int:
-    return sizes.sweep_cost(designs, min(chunk, designs), samples, area, processes, BLOCK)
-
-
-def _check_memory(
-    grid: Any, samples: int, chunk: int, area: int, processes: int, workers: int | None
-) -> None:
-    """The sweep's sizes against the memory limit (:mod:`rpr3gen.sizes`), each with those
-    before it as given and those after it at their least: the area's resolution, the number of
-    designs, the worker processes."""
-    sizes.check("area_resolution", area, lambda a: _sweep_cost(1, 1, samples, a, 1),
-                "each design's workspace area", argument="area_resolution")  # fmt: skip
-    sizes.check(grid.source, len(grid), lambda d: _sweep_cost(d, chunk, samples, area, 1),
-                "the sweep's results and tasks", least=1, unit="designs",
-                error=GridError)  # fmt: skip
-    if processes > 1:
-        designs = len(grid)
-        sizes.check("workers" if workers else "workers (one per core)", processes,
-                    lambda w: _sweep_cost(designs, chunk, samples, area, w),
-                    "the local cluster's processes and their tasks", least=1,
-                    argument="workers")  # fmt: skip
 
 
 def _trajectories(
