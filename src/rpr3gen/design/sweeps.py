@@ -49,9 +49,7 @@ from rpr3gen.trajectory import (
     Trajectory,
     paper_trajectory,
 )
-from rpr3gen.validation import (
-    checked,
-)
+from rpr3gen.validation import checked
 
 __all__ = [
     "DEFAULT_AREA_RESOLUTION",
