@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING, Any
 import jinja2
 from rpr3gen_derive.codegen import mathkernels
 from rpr3gen_derive.codegen.backends.c.batch import NotSplittableError, plan
+from rpr3gen_derive.codegen.backends.c.order import Line, schedule
 from rpr3gen_derive.codegen.backends.c.printer import c_code, fast_trig_arguments
 from rpr3gen_derive.codegen.spec import ModuleSpec
 
@@ -51,6 +52,24 @@ def comment(text: str, first: str, rest: str, width: int = WIDTH - 4) -> str:
 
 def _lines(statements: Any, prefix: str, fast: bool = False) -> list[tuple[str, str]]:
     return [(str(lhs), c_code(rhs, prefix, fast)) for lhs, rhs in statements]
+
+
+def _kernel_lines(c: Compiled, prefix: str, outputs: list[tuple[str, int, str]]) -> list[Line]:
+    """The single-sample kernel's loads, assignments and output stores, scheduled
+    (:func:`.order.schedule`) so that few values are live at once."""
+
+    def names(expr: Any) -> frozenset[str]:
+        return frozenset(str(s) for s in expr.free_symbols)
+
+    none: frozenset[str] = frozenset()
+    lines = [Line("load", name, none, (f"params[{k}]",)) for k, name in c.used_params]
+    lines += [Line("load", name, none, (f"{arg}[{k}]",)) for arg, k, name in c.used_inputs]
+    lines += [Line("assign", str(lhs), names(rhs), (c_code(rhs, prefix),))
+              for lhs, rhs in c.code.assignments]  # fmt: skip
+    stored = zip(outputs, c.code.outputs, strict=True)
+    lines += [Line("store", "", names(e), (out, str(index), text))
+              for (out, index, text), (_, e) in stored]  # fmt: skip
+    return schedule(lines)
 
 
 def _function(module: ModuleSpec, c: Compiled) -> dict[str, Any]:
@@ -115,7 +134,7 @@ def _function(module: ModuleSpec, c: Compiled) -> dict[str, Any]:
         "used_params": c.used_params,
         "used_inputs": c.used_inputs,
         "assignments": _lines(c.code.assignments, prefix),
-        "outputs": outputs(enumerate(e for _, e in c.code.outputs)),
+        "kernel_lines": _kernel_lines(c, prefix, outputs(enumerate(e for _, e in c.code.outputs))),
         "input_code": input_code,
         "custom_code": custom_code,
         "checks": checks,
