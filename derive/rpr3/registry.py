@@ -609,6 +609,8 @@ def forward_kinematics(actuation: str) -> FunctionSpec:
         program=Program(),
         checks=(Check("inputs_not_finite", "NOT_FINITE"), Check("custom", "NO_MODE")),
         c_body="forward_kinematics.c.jinja",
+        c_kernels=("trig", "minmax"),
+        c_values=("actuator_coordinates", "actuator_jacobian"),
         c_context=(
             ("actuation", actuation),
             ("max_modes", direct_kinematics.MAX_MODES[actuation]),
