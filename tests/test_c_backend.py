@@ -320,3 +320,24 @@ def test_threads_must_be_positive() -> None:
     with pytest.raises(SystemExit) as exit_info:
         main(["simulate", "--backend", "c", "--threads", "0"])
     assert exit_info.value.code == 2
+
+
+def test_sample_evaluators_share_buffers() -> None:
+    """One evaluator's output as another's input, with no copy (the control loop's tick)."""
+    model = _model(ne.paper_params(), "revolute")
+    fk = rpr3gen.SampleEvaluator(model, function="forward_kinematics")
+    vel = rpr3gen.SampleEvaluator(model, function="platform_velocity", buffers={"q": fk.q})
+    assert vel.q is fk.q
+    q = np.array([0.01, -0.02, 0.1])
+    fk.qa[:] = rpr3gen.actuator_coordinates(model, q[None, :])[0]
+    fk.q_near[:] = q
+    vel.qa_dot[:] = (0.1, 0.2, 0.3)
+    assert fk() == 0
+    assert vel() == 0
+    alone = rpr3gen.SampleEvaluator(model, function="platform_velocity")
+    alone.q[:], alone.qa_dot[:] = fk.q, vel.qa_dot
+    assert alone() == 0
+    assert alone.qd.tobytes() == vel.qd.tobytes()
+    for bad in ({"q": np.zeros(4)}, {"q": np.zeros(3, dtype=np.float32)}, {"x": np.zeros(3)}):
+        with pytest.raises(rpr3gen.InputError):
+            rpr3gen.SampleEvaluator(model, function="platform_velocity", buffers=bad)

@@ -97,9 +97,15 @@ class Controller:
         # computed-torque law are generated too, so the tick does no 3 x 3 algebra in Python:
         # platform_velocity solves J qd = qa'; actuator_efforts at the commanded acceleration a
         # is tau = J^-T (M a + c) (the C program writes that law out with task_space_dynamics).
+        # They share buffers: the pose the forward kinematics writes is the q the other two
+        # read, the velocity platform_velocity writes is the qd actuator_efforts reads.
         self.fk = rpr3gen.SampleEvaluator(model, function="forward_kinematics")
-        self.velocity = rpr3gen.SampleEvaluator(model, function="platform_velocity")
-        self.efforts = rpr3gen.SampleEvaluator(model, function="actuator_efforts")
+        self.velocity = rpr3gen.SampleEvaluator(
+            model, function="platform_velocity", buffers={"q": self.fk.q}
+        )
+        self.efforts = rpr3gen.SampleEvaluator(
+            model, function="actuator_efforts", buffers={"q": self.fk.q, "qd": self.velocity.qd}
+        )
         self.resolution, self.amplitude = resolution, amplitude.tolist()
         self.alpha = 1.0 - math.exp(-2.0 * math.pi * RATE_CUTOFF_HZ / RATE_HZ)
         self.q1 = [0.0, 0.0, 0.0]  # the last two pose estimates; the robot was parked at home
@@ -133,13 +139,12 @@ class Controller:
         fk_end = clock()
         if status:
             self.failed["forward kinematics"] += 1
-            q = list(near)  # coast on the prediction
-        else:
-            q = fk.q.tolist()
+            fk.q[:] = near  # coast on the prediction
+        q = fk.q.tolist()
         self.q2, self.q1 = (q if first else q1), q  # at first, at rest
         # the velocity: J qd = qa' (the "jacobian" count is this solve's failures)
         vel = self.velocity
-        vel.q[:], vel.qa_dot[:] = q, self.rate
+        vel.qa_dot[:] = self.rate
         if vel():
             self.failed["jacobian"] += 1
         else:
@@ -148,7 +153,6 @@ class Controller:
             w = math.pi / DURATION
             c, s = math.cos(w * t), math.sin(w * t)
             eff = self.efforts
-            eff.q[:], eff.qd[:] = q, qd
             eff.qdd[:] = [a * (w * w * c) + KD * (a * (w * s) - v) + KP * (a * (1.0 - c) - x)
                           for a, v, x in zip(self.amplitude, qd, q, strict=True)]  # fmt: skip
             if eff():
