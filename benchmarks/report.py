@@ -50,11 +50,12 @@ def header(r: dict[str, Any]) -> str:
 
 
 def c_figures(r: dict[str, Any], key: str) -> dict[str, dict[str, float]]:
-    """``{function: {"floor", "single", "batch": ns, "agree": 0|1}}``: medians of the repeats."""
+    """``{function: {"floor", "single", "batch": ns, "agree": 0|1}}``: the best of the repeats
+    (the least disturbed by other processes: the machine is shared)."""
     found: dict[str, dict[str, float]] = {}
     for name, value in r["c"][key]["results"].items():
         function, what = name.split("/")
-        found.setdefault(function, {})[what] = value["agree"] if what == "agree" else value["p50"]
+        found.setdefault(function, {})[what] = value["agree"] if what == "agree" else value["min"]
     return found
 
 
@@ -64,7 +65,7 @@ def variants(r: dict[str, Any]) -> list[str]:
 
 def py(r: dict[str, Any], name: str) -> float | None:
     found = r["python"].get(name)
-    return None if found is None else float(found["median"])
+    return None if found is None else float(found["min"])
 
 
 def ne_ratios(r: dict[str, Any], variant: str) -> list[tuple[str, int, float, float]]:
@@ -142,7 +143,7 @@ def functions(r: dict[str, Any], v: str) -> str:
                  "", "yes" if rot["agree"] == 1 else "**no**"])  # fmt: skip
     flags = r["c"][f"{v}/generic"]["flags"]
     head = ["function", "floor", "C single", "C batch", "NumPy", "single = batch"]
-    return f"**{v}** (`cc {flags}`; ns per sample, median of the repeats):\n\n" + table(head, rows)
+    return f"**{v}** (`cc {flags}`; ns per sample, best of the repeats):\n\n" + table(head, rows)
 
 
 def numpy_vs_ne(r: dict[str, Any]) -> str:
@@ -192,7 +193,7 @@ def document(r: dict[str, Any]) -> str:
         *(functions(r, v) + "\n" for v in variants(r)),
         "## NumPy against Newton–Euler\n",
         "`evaluate(model, \"inverse_dynamics\", ...)` against `tests/newton_euler.py` on the same "
-        "samples (in chunks of 10^5), ns per sample, pyperf medians.\n\n", numpy_vs_ne(r),
+        "samples (in chunks of 10^5), ns per sample, the best of pyperf's values.\n\n", numpy_vs_ne(r),
         "\n## The control-loop examples' latencies\n",
         "Each program's own report, 3 s at 1 kHz (`examples/control_loop`).\n\n",
         control_loop(r),
