@@ -193,7 +193,8 @@ def document(r: dict[str, Any]) -> str:
         *(functions(r, v) + "\n" for v in variants(r)),
         "## NumPy against Newton–Euler\n",
         "`evaluate(model, \"inverse_dynamics\", ...)` against `tests/newton_euler.py` on the same "
-        "samples (in chunks of 10^5), ns per sample, the best of pyperf's values.\n\n", numpy_vs_ne(r),
+        "samples (in chunks of 10^5), ns per sample, the best of pyperf's values.\n\n",
+        numpy_vs_ne(r),
         "\n## The control-loop examples' latencies\n",
         "Each program's own report, 3 s at 1 kHz (`examples/control_loop`).\n\n",
         control_loop(r),
