@@ -97,6 +97,15 @@ def run_pyperf(group: str, quick: bool) -> dict[str, dict[str, float]]:
     }  # fmt: skip
 
 
+def dump(value: Any, indent: str = "") -> str:
+    """JSON with one measurement a line: a dict of numbers and strings stays on one line."""
+    if not isinstance(value, dict) or not any(isinstance(v, dict) for v in value.values()):
+        return json.dumps(value, sort_keys=True)
+    inner = indent + " "
+    items = [f"{inner}{json.dumps(k)}: {dump(v, inner)}" for k, v in sorted(value.items())]
+    return "{\n" + ",\n".join(items) + "\n" + indent + "}"
+
+
 def results_path(quick: bool) -> Path:
     """Where a run's results go: ``results.json``, or ``results-quick.json`` (ignored by git) with
     ``--quick``, so that a quick run never replaces the committed full results."""
@@ -126,7 +135,7 @@ def main() -> int:
     results["load_end"] = os.getloadavg()
     results["seconds"] = round(time.monotonic() - start)
     out = results_path(args.quick)
-    out.write_text(json.dumps(results, indent=1, sort_keys=True) + "\n")
+    out.write_text(dump(results) + "\n")
     log(f"wrote {out.relative_to(REPO)}")
     report.main([str(out), *(["--readme"] if args.readme else [])])
     return 0
