@@ -1,99 +1,145 @@
-"""Benchmarks of rpr3gen: regeneration, NumPy and C backends, Python calls, peers, control model.
+"""Every benchmark of rpr3gen in one command: ``python benchmarks/run.py [--quick] [--readme]``.
 
-Run from anywhere with the project's interpreter (rpr3gen installed with the ``dev`` extra)::
-
-    python benchmarks/run.py                # full run; writes benchmarks/results.md
-    python benchmarks/run.py --quick        # fewer repeats, no 10^7 samples; results-quick.md
-    python benchmarks/run.py --out FILE.md  # write the Markdown elsewhere
-    python benchmarks/run.py --only control # one section (several: --only c --only python);
-                                            # writes benchmarks/results-only-control.md
-    python benchmarks/run.py --readme       # full run, and README.md's performance tables
-
-It prints the report (Markdown) on stdout, progress on stderr, and writes the same Markdown to
-``--out``. The measurements live in the package ``rpr3bench`` beside this file (``workers``:
-what runs in a fresh interpreter, ``sections``: what each section runs and shows, ``report``:
-tables, machine, targets; ``charness``: ``bench.c``). See ``benchmarks/README.md``.
+Runs, over every variant in ``generated/``: the C per-function harness (``harness/cbench.py``:
+floor, single call, batch), the control-loop examples (``harness/examples.py``: their own tick
+latencies) and the Python benchmarks on pyperf (``harness/pybench.py``, one pyperf run per
+group, fresh worker processes). Writes ``benchmarks/results.json`` (every figure, the machine
+and its load average at the start and the end), then ``report.py`` turns it into
+``benchmarks/results.md`` and, with ``--readme``, README.md's Performance tables. ``--quick``
+(fewer repeats, ~2 minutes) writes ``results-quick.json`` and ``results-quick.md`` instead, so
+that it never replaces the committed full results.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
+import platform
+import subprocess
 import sys
+import tempfile
 import time
-from collections.abc import Sequence
+from datetime import UTC, datetime
 from pathlib import Path
+from typing import Any
 
-from rpr3bench import report, sections, workers
-from rpr3bench.common import BENCH, log
+import numpy as np
+import pyperf
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import report
+from harness import cbench, examples, samples
+
+BENCH = Path(__file__).resolve().parent
+REPO = BENCH.parent
+#: pyperf's options per group, full run / quick run (None: skipped).
+PYPERF: dict[str, tuple[list[str], list[str] | None]] = {
+    "numpy": (["--processes", "2", "--values", "3"], ["--processes", "1", "--values", "1"]),
+    "large": (["--processes", "1", "--values", "2", "--loops", "1"], None),
+    "functions": (["--processes", "2", "--values", "3"], ["--processes", "1", "--values", "1"]),
+    "calls": (["--processes", "3", "--values", "5"], ["--processes", "1", "--values", "3"]),
+    "peers": (["--processes", "2", "--values", "3"], ["--processes", "1", "--values", "2"]),
+    "regen": (
+        ["--processes", "1", "--values", "3", "--loops", "1"],
+        ["--processes", "1", "--values", "1", "--loops", "1"],
+    ),
+}
 
 
-def report_path(out: str | None, quick: bool, only: list[str] | None = None) -> Path:
-    """Where the report goes: ``--out``, else ``results.md``, or ``results-quick.md`` with
-    ``--quick``, or ``results-only-KEY[-quick].md`` with ``--only``, so that neither a quick
-    nor a partial run replaces the committed full results."""
-    if out:
-        return Path(out)
-    if only:
-        keys = [key for key in sections.SECTIONS if key in only]
-        return BENCH / f"results-only-{'-'.join(keys)}{'-quick' if quick else ''}.md"
-    return BENCH / ("results-quick.md" if quick else "results.md")
+START = time.monotonic()
 
 
-def main(argv: Sequence[str] | None = None) -> int:
+def log(message: str) -> None:
+    print(f"[bench {time.monotonic() - START:5.0f} s] {message}", file=sys.stderr, flush=True)
+
+
+def machine() -> dict[str, Any]:
+    """CPU, cores, memory, versions and commit: what a figure depends on."""
+    info = Path("/proc/cpuinfo").read_text() if Path("/proc/cpuinfo").exists() else ""
+    cpu = next((line.split(":", 1)[1].strip() for line in info.splitlines()
+                if line.startswith("model name")), platform.processor())  # fmt: skip
+    cc = subprocess.run([*cbench.CC, "--version"], capture_output=True, text=True, check=False)
+    git = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=REPO,
+                         capture_output=True, text=True, check=False)  # fmt: skip
+    dirty = subprocess.run(["git", "status", "--porcelain", "--", "derive", "generated", "src"],
+                           cwd=REPO, capture_output=True, text=True, check=False)  # fmt: skip
+    return {
+        "cpu": cpu,
+        "cores": os.cpu_count(),
+        "usable_cores": len(os.sched_getaffinity(0)),
+        "python": platform.python_version(),
+        "numpy": np.__version__,
+        "pyperf": pyperf.__version__,
+        "cc": cc.stdout.splitlines()[0] if cc.stdout else "?",
+        "commit": git.stdout.strip() + (" (modified)" if dirty.stdout.strip() else ""),
+        "date": datetime.now(UTC).strftime("%Y-%m-%d %H:%M UTC"),
+    }
+
+
+def run_pyperf(group: str, quick: bool) -> dict[str, dict[str, float]]:
+    """One pyperf run of a group of ``harness/pybench.py``: median, min (s) and counts."""
+    options = PYPERF[group][1 if quick else 0]
+    if options is None:
+        return {}
+    with tempfile.TemporaryDirectory(prefix="rpr3bench-pyperf-") as tmp:
+        out = Path(tmp) / f"{group}.json"
+        subprocess.run(
+            [sys.executable, str(BENCH / "harness" / "pybench.py"), group, "--quiet",
+             "--warmups", "1", *options, "-o", str(out)],
+            check=True,
+        )  # fmt: skip
+        suite = pyperf.BenchmarkSuite.load(str(out))
+    return {
+        b.get_name(): {"median": b.median(), "min": min(b.get_values()),
+                       "values": b.get_nvalue(), "loops": b.get_loops()}
+        for b in suite.get_benchmarks()
+    }  # fmt: skip
+
+
+def dump(value: Any, indent: str = "") -> str:
+    """JSON with one measurement a line: a dict of numbers and strings stays on one line."""
+    if not isinstance(value, dict) or not any(isinstance(v, dict) for v in value.values()):
+        return json.dumps(value, sort_keys=True)
+    inner = indent + " "
+    items = [f"{inner}{json.dumps(k)}: {dump(v, inner)}" for k, v in sorted(value.items())]
+    return "{\n" + ",\n".join(items) + "\n" + indent + "}"
+
+
+def results_path(quick: bool) -> Path:
+    """Where a run's results go: ``results.json``, or ``results-quick.json`` (ignored by git) with
+    ``--quick``, so that a quick run never replaces the committed full results."""
+    return BENCH / ("results-quick.json" if quick else "results.json")
+
+
+def main() -> int:
     parser = argparse.ArgumentParser(description=(__doc__ or "").split("\n", 1)[0])
-    parser.add_argument("--quick", action="store_true", help="fewer repeats, no 10^7 NumPy run")
-    parser.add_argument(
-        "--out",
-        help="Markdown report file (default: benchmarks/results.md, with --quick "
-        "benchmarks/results-quick.md)",
-    )
-    parser.add_argument(
-        "--only",
-        action="append",
-        choices=list(sections.SECTIONS),
-        help="run only this section (repeat for several): "
-        + ", ".join(f"{key} ({title})" for key, title in sections.SECTIONS.items()),
-    )
-    parser.add_argument(
-        "--readme",
-        action="store_true",
-        help="also write the run's targets and speed tables into README.md (between its "
-        "performance markers)",
-    )
-    parser.add_argument("--worker", help=argparse.SUPPRESS)  # one measurement, in this process
-    parser.add_argument("--args", default="{}", help=argparse.SUPPRESS)
-    args = parser.parse_args(argv)
-    if args.readme and args.only:
-        parser.error("--readme takes a run of every section (no --only)")
-    if args.worker:
-        print(json.dumps(workers.work(args.worker, json.loads(args.args))))
-        return 0
-
-    started = time.perf_counter()
-    info = report.machine()
-    parts, results = sections.run_all(args.quick, args.only)
-    info["load average (end)"] = report.loadavg()
-    kind = "--quick" if args.quick else "full"
-    if args.only:
-        kind += ", only " + ", ".join(args.only)
-    info["run"] = f"{kind}, {time.perf_counter() - started:.0f} s"
-    command = "python benchmarks/run.py" + (" --quick" if args.quick else "")
-    command += "".join(f" --only {key}" for key in args.only or [])
-    text = report.document(command, info, results, parts)
-    print(text)
-    out = report_path(args.out, args.quick, args.only)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(text)
-    log(f"wrote {out}")
-    if args.readme:
-        readme = BENCH.parent / "README.md"
-        if not report.update_readme(readme, report.readme_block(command, info, results)):
-            log(f"{readme} has no performance markers: not written")
-            return 1
-        log(f"wrote the performance tables of {readme}")
+    parser.add_argument("--quick", action="store_true", help="fewer repeats; results-quick.*")
+    parser.add_argument("--readme", action="store_true", help="also README.md's tables")
+    args = parser.parse_args()
+    start = time.monotonic()
+    results: dict[str, Any] = {"machine": machine(), "quick": args.quick,
+                               "load_start": os.getloadavg()}  # fmt: skip
+    n, repeats = (20_000, 3) if args.quick else (100_000, 9)
+    results["c"] = {}
+    for variant in samples.variants():
+        for motion in samples.MOTIONS:
+            log(f"C functions: {variant}, {motion} motion")
+            results["c"][f"{variant}/{motion}"] = cbench.run(variant, motion, n, repeats)
+    log("control-loop examples")
+    results["examples"] = examples.run()
+    results["python"] = {}
+    for group in PYPERF:
+        log(f"pyperf: {group}")
+        results["python"].update(run_pyperf(group, args.quick))
+    results["load_end"] = os.getloadavg()
+    results["seconds"] = round(time.monotonic() - start)
+    out = results_path(args.quick)
+    out.write_text(dump(results) + "\n")
+    log(f"wrote {out.relative_to(REPO)}")
+    report.main([str(out), *(["--readme"] if args.readme else [])])
     return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    raise SystemExit(main())

@@ -576,8 +576,7 @@ def tracked_forward_kinematics(
 
     1. :func:`closure_newton` from ``q_near`` (at most ``max_iter`` steps, largest residual
        ``<= tol``, step limited to ``rho`` in the pose metric, backtracking line search).
-    2. Accepted when it converged, every leg length is positive, the pose is one the generated
-       code evaluates (:func:`reach` above :data:`MIN_REACH`), and ``det J`` at the solution
+    2. Accepted when it converged, every leg length is positive, and ``det J`` at the solution
        has the sign it has at ``q_near`` (same aspect: Newton did not jump across a parallel
        singularity into another mode).
     3. Otherwise (fallback): every mode, by the closed form (revolute) or by sampling the sextic
@@ -603,7 +602,7 @@ def tracked_forward_kinematics(
             if actuation == "revolute"
             else min(math.hypot(*di) for di in d)
         ) > LENGTH_TOL * geom.rho
-        if positive and reach(geom, result.q) > MIN_REACH and det_near * det_here > 0:
+        if positive and det_near * det_here > 0:
             return Tracked(result.q, "newton", result.iterations)
     if not fallback:
         return Tracked((math.nan, math.nan, math.nan), "none", result.iterations)

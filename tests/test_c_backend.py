@@ -84,6 +84,49 @@ def test_single_and_batch_agree_bit_for_bit(actuation: str) -> None:
         assert out.tobytes() == rows[i].tobytes(), i
 
 
+def _same_bits(a: np.ndarray, b: np.ndarray) -> bool:
+    """Equal bits, or both NaN (the payload of a NaN depends on its operands' order)."""
+    return bool(np.all((a.view(np.int64) == b.view(np.int64)) | (np.isnan(a) & np.isnan(b))))
+
+
+def _generic_inputs(model: Model, function: manifest.FunctionInfo) -> list[np.ndarray] | None:
+    """A function's inputs along a motion in which x, y and phi all move; None if unknown."""
+    t = np.linspace(0.0, 3.0, 301)[:, None]
+    amplitude, rate = np.array([0.03, 0.025, 0.2]), np.array([2.1, 2.7, 3.6])
+    q = amplitude * np.sin(rate * t + [0.0, 0.7, 1.9])
+    qd = amplitude * rate * np.cos(rate * t + [0.0, 0.7, 1.9])
+    motion = {"q": q, "qd": qd, "qdd": -(rate**2) * q, "qa_dot": np.cos(rate * t),
+              "tau": np.sin(rate * t)}  # fmt: skip
+    motion["qa"] = rpr3gen.actuator_coordinates(model, q)
+    motion["q_near"] = q
+    if not all(a.name in motion for a in function.inputs):
+        return None
+    return [np.ascontiguousarray(motion[a.name]) for a in function.inputs]
+
+
+@pytest.mark.parametrize("actuation", ACTUATIONS)
+def test_every_function_single_and_batch_agree_bit_for_bit(actuation: str) -> None:
+    """The runtime's library (its flags: gcc's basic-block vectoriser once fused multiply-adds in
+    a single call and not in the batch, issue 20), every function, a generic motion."""
+    model = _model(ne.paper_params(), actuation)
+    checked = []
+    for name, function in manifest.load(actuation).functions.items():
+        inputs = _generic_inputs(model, function)
+        if inputs is None:
+            continue
+        batch, codes = rpr3gen.evaluate(model, name, inputs, backend="c")
+        ev = rpr3gen.SampleEvaluator(model, function=name)
+        for i in range(len(inputs[0])):
+            for arg, values in zip(function.inputs, inputs, strict=True):
+                ev.inputs[arg.name][:] = values[i]
+            assert ev() == codes[i], (name, i)
+            if codes[i] == 0:
+                for out, rows in zip(ev.outputs.values(), batch, strict=False):
+                    assert _same_bits(out, rows[i]), (name, i, out, rows[i])
+        checked.append(name)
+    assert {"inverse_dynamics", "assembly_modes", "forward_kinematics"} <= set(checked)
+
+
 def _singular_sample(model: Model) -> np.ndarray:
     p = model.params  # platform joint B3 on the base pivot B1: leg B has zero length
     return np.array([p["xB1"] - p["xB3"], p["yB1"] - p["yB3"], 0.0])
@@ -278,3 +321,24 @@ def test_threads_must_be_positive() -> None:
     from rpr3gen.cli import main
 
     assert main(["simulate", "--backend", "c", "--threads", "0"]) == 2
+
+
+def test_sample_evaluators_share_buffers() -> None:
+    """One evaluator's output as another's input, with no copy (the control loop's tick)."""
+    model = _model(ne.paper_params(), "revolute")
+    fk = rpr3gen.SampleEvaluator(model, function="forward_kinematics")
+    vel = rpr3gen.SampleEvaluator(model, function="platform_velocity", buffers={"q": fk.q})
+    assert vel.q is fk.q
+    q = np.array([0.01, -0.02, 0.1])
+    fk.qa[:] = rpr3gen.actuator_coordinates(model, q[None, :])[0]
+    fk.q_near[:] = q
+    vel.qa_dot[:] = (0.1, 0.2, 0.3)
+    assert fk() == 0
+    assert vel() == 0
+    alone = rpr3gen.SampleEvaluator(model, function="platform_velocity")
+    alone.q[:], alone.qa_dot[:] = fk.q, vel.qa_dot
+    assert alone() == 0
+    assert alone.qd.tobytes() == vel.qd.tobytes()
+    for bad in ({"q": np.zeros(4)}, {"q": np.zeros(3, dtype=np.float32)}, {"x": np.zeros(3)}):
+        with pytest.raises(rpr3gen.InputError):
+            rpr3gen.SampleEvaluator(model, function="platform_velocity", buffers=bad)

@@ -50,7 +50,7 @@ def _report(text: str) -> dict[str, float]:
     assert m, text
     numbers["estimate mm"], numbers["estimate mrad"] = map(float, m.groups())
     assert "failed calls: forward kinematics 0, jacobian 0, dynamics 0" in text, text
-    for label in ("forward kinematics", "dynamics", "whole tick"):
+    for label in ("forward kinematics", "rest of the tick", "whole tick"):
         pattern = rf"latency {label}: p50 [\d.]+ (ns|us), p99 [\d.]+ \1, max [\d.]+ \1\n"
         assert re.search(pattern, text), text
     return numbers
@@ -90,37 +90,75 @@ def c_build(repo_root: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 def _run_c(work: Path, actuation: str, *args: str) -> str:
     result = subprocess.run(
-        [f"./control_loop_{actuation}", "paper.params", *args],
+        [f"./control_loop_{actuation}", *args],
         cwd=work, capture_output=True, text=True, check=False,
     )  # fmt: skip
     assert result.returncode == 0, result.stdout + result.stderr
     return result.stdout
 
 
-def _run_python(repo_root: Path, actuation: str, trajectory: str) -> str:
+def _run_python(repo_root: Path, actuation: str, *args: str, cwd: Path | None = None) -> str:
     script = repo_root / "examples" / "control_loop" / "control_loop.py"
-    command = [sys.executable, str(script), "--actuation", actuation, "--trajectory", trajectory]
     result = subprocess.run(
-        [*command, "--seconds", "0.4"], capture_output=True, text=True, check=False
-    )
+        [sys.executable, str(script), "--actuation", actuation, *args],
+        cwd=cwd, capture_output=True, text=True, check=False,
+    )  # fmt: skip
     assert result.returncode == 0, result.stdout + result.stderr
     return result.stdout
 
 
 @pytest.mark.parametrize(("actuation", "trajectory"), CASES)
 def test_c_control_loop(c_build: Path, actuation: str, trajectory: str) -> None:
-    _check_tracking(_run_c(c_build, actuation, trajectory, "0.4"), actuation, trajectory)
+    text = _run_c(c_build, actuation, "--trajectory", trajectory, "--seconds", "0.4")
+    _check_tracking(text, actuation, trajectory)
 
 
 @pytest.mark.parametrize(("actuation", "trajectory"), CASES)
 def test_python_control_loop(repo_root: Path, actuation: str, trajectory: str) -> None:
-    _check_tracking(_run_python(repo_root, actuation, trajectory), actuation, trajectory)
+    text = _run_python(repo_root, actuation, "--trajectory", trajectory, "--seconds", "0.4")
+    _check_tracking(text, actuation, trajectory)
 
 
 def test_c_and_python_close_the_same_loop(repo_root: Path, c_build: Path) -> None:
-    c = _report(_run_c(c_build, "revolute", "rotation", "0.4"))
-    py = _report(_run_python(repo_root, "revolute", "rotation"))
+    c = _report(_run_c(c_build, "revolute", "--trajectory", "rotation", "--seconds", "0.4"))
+    py = _report(_run_python(repo_root, "revolute", "--trajectory", "rotation", "--seconds", "0.4"))
     assert c == pytest.approx(py, abs=2e-4)  # same plant, sensors and law; 4 decimals printed
+
+
+@pytest.mark.parametrize(
+    "args",
+    [
+        ("rotation", "--seconds", "0.4"),
+        ("--trajectory", "rotation", "--seconds=0.4"),
+        ("--params", "paper.params", "--seconds", "0.4", "--offset", "0", "rotation"),
+    ],
+)
+def test_c_and_python_take_the_same_arguments(
+    repo_root: Path, c_build: Path, args: tuple[str, ...]
+) -> None:
+    """Issue 21: the same command line runs either program (the trajectory positional or as
+    --trajectory, the model's numbers from --params), and both report the same loop."""
+    c = _run_c(c_build, "revolute", *args)
+    py = _run_python(repo_root, "revolute", *args, cwd=c_build)
+    assert (
+        c.splitlines()[0]
+        == py.splitlines()[0]
+        == (
+            "trajectory rotation, 400 ticks at 1000 Hz, revolute actuation, "
+            "start offset (0.000, 0.000) mm"
+        )
+    )
+    assert _report(c) == pytest.approx(_report(py), abs=2e-4)
+
+
+def test_a_bad_argument_is_refused_by_both(repo_root: Path, c_build: Path) -> None:
+    script = repo_root / "examples" / "control_loop" / "control_loop.py"
+    for command in (["./control_loop_revolute"], [sys.executable, str(script)]):
+        result = subprocess.run(
+            [*command, "--seconds", "soon"], cwd=c_build, capture_output=True, text=True
+        )
+        assert result.returncode == 2, result.stdout + result.stderr
+        assert "usage:" in result.stderr
 
 
 def test_c_control_loop_start_offset(repo_root: Path, c_build: Path) -> None:
@@ -128,7 +166,7 @@ def test_c_control_loop_start_offset(repo_root: Path, c_build: Path) -> None:
 
     The example's README explains the largest error this prints: the start itself.
     """
-    text = _run_c(c_build, "revolute", "rectilinear", "0.4", "1")
+    text = _run_c(c_build, "revolute", "rectilinear", "--seconds", "0.4", "--offset", "1")
     assert "start offset (1.000, -1.000) mm" in text, text
     numbers = _report(text)  # no failed forward kinematics from 1.4 mm off
     assert numbers["overall pos_max"] == pytest.approx(2**0.5, abs=0.01), text  # the offset

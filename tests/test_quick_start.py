@@ -51,9 +51,9 @@ def test_quick_benchmark_run_keeps_the_committed_full_results(
     assert spec.loader is not None
     bench = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(bench)
-    full = repo_root / "benchmarks" / "results.md"
-    assert bench.report_path(None, quick=False) == full
-    assert bench.report_path(None, quick=True) == repo_root / "benchmarks" / "results-quick.md"
-    assert bench.report_path("x.md", quick=True) == Path("x.md")
+    assert bench.results_path(quick=False) == repo_root / "benchmarks" / "results.json"
+    quick = bench.results_path(quick=True)
+    assert quick == repo_root / "benchmarks" / "results-quick.json"
     ignored = (repo_root / ".gitignore").read_text(encoding="utf-8").splitlines()
-    assert "/benchmarks/results-quick.md" in ignored
+    for suffix in (".json", ".md"):  # report.py writes the Markdown beside the results
+        assert f"/benchmarks/{quick.with_suffix(suffix).name}" in ignored

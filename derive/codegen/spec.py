@@ -147,6 +147,12 @@ class FunctionSpec:
     checks: tuple[Check, ...] = ()
     c_body: str | None = None
     c_context: tuple[tuple[str, object], ...] = ()
+    #: Math kernels the hand-written body calls (names of ``mathkernels.used``: ``"trig"``,
+    #: ``"atan2"``, ``"rint"``, ``"minmax"``), emitted whether or not another function needs them.
+    c_kernels: tuple[str, ...] = ()
+    #: Functions whose values-only kernel (``{prefix}_{name}_values``: the public outputs, no
+    #: check, no hidden output) the hand-written body calls.
+    c_values: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         guards = [c.guard for c in self.checks if c.guard is not None]

@@ -704,6 +704,8 @@ def forward_kinematics(structure: Structure) -> FunctionSpec:
         program=Program(),
         checks=(Check("inputs_not_finite", "NOT_FINITE"), Check("custom", "NO_MODE")),
         c_body="forward_kinematics.c.jinja",
+        c_kernels=("minmax",),
+        c_values=("actuator_coordinates", "actuator_jacobian"),
         c_context=(
             ("kind", fk_kind(structure)),
             ("wrap", structure.actuated_kind == "R"),

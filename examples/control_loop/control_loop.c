@@ -11,12 +11,14 @@
  *   M, c  = rpr3_task_space_dynamics(q, q')
  *   tau   : J^T tau = M (qdd_d + Kd (qd_d - q') + Kp (q_d - q)) + c
  * Prints the tracking error, the pose and velocity estimates' errors, the failed calls and the
- * latency (p50, p99, max) of the forward kinematics, of the dynamics (M, c and the solve) and of
- * the whole tick. The variant (actuation) is the generated folder the program is built with.
+ * latency (p50, p99, max) of the forward kinematics, of the rest of the tick (velocity, reference,
+ * dynamics, law) and of the whole tick. The variant (actuation) is the generated folder the
+ * program is built with. The arguments are control_loop.py's (but --model and --actuation):
  *
- *   make && ./control_loop_revolute paper.params [rectilinear|rotation] [SECONDS] [OFFSET_MM]
+ *   make && ./control_loop_revolute [--params FILE] [--trajectory rectilinear|rotation]
+ *                                   [--seconds T] [--offset MM] [rectilinear|rotation]
  *
- * paper.params: "name value" lines, e.g. from `rpr3gen params > paper.params`.
+ * --params FILE (default paper.params): "name value" lines, e.g. `rpr3gen params > paper.params`.
  */
 #define _POSIX_C_SOURCE 199309L
 
@@ -94,42 +96,43 @@ static double now_ns(void)
 /* Paper eq. (3), q = q* (1 - cos(pi t / T)), and its first two derivatives. */
 static void reference(const double *amplitude, double t, double *q, double *qd, double *qdd)
 {
-    const double w = PI / DURATION;
+    const double w = PI / DURATION, c = cos(w * t), s = sin(w * t);
     int k;
     for (k = 0; k < 3; ++k) {
-        q[k] = amplitude[k] * (1.0 - cos(w * t));
-        qd[k] = amplitude[k] * (w * sin(w * t));
-        qdd[k] = amplitude[k] * (w * w * cos(w * t));
+        q[k] = amplitude[k] * (1.0 - c);
+        qd[k] = amplitude[k] * (w * s);
+        qdd[k] = amplitude[k] * (w * w * c);
     }
 }
 
 /* Solves A x = b (transpose = 0) or A^T x = b (transpose = 1), A 3x3 row-major, by the
- * cofactors: A^-1 = C^T / det A. Returns -1, x untouched, when A is singular to round-off. */
+ * cofactors: A^-1 = C^T / det A. Returns -1, x untouched, when A is singular to round-off:
+ * |det A| at most 1e-12 times the product of its row norms (compared squared: no sqrt). */
 static int solve3(const double *a, const double *b, int transpose, double *x)
 {
-    double cof[9], det, scale = 1.0, y[3];
-    int i, j;
-    for (i = 0; i < 3; ++i) {
-        const double *r1 = a + 3 * ((i + 1) % 3), *r2 = a + 3 * ((i + 2) % 3);
-        for (j = 0; j < 3; ++j) {
-            const int j1 = (j + 1) % 3, j2 = (j + 2) % 3;
-            cof[3 * i + j] = r1[j1] * r2[j2] - r1[j2] * r2[j1];
-        }
-        scale *= sqrt(a[3 * i] * a[3 * i] + a[3 * i + 1] * a[3 * i + 1] + a[3 * i + 2] * a[3 * i + 2]);
-    }
-    det = a[0] * cof[0] + a[1] * cof[1] + a[2] * cof[2];
-    if (!(fabs(det) > 1e-12 * scale)) {
+    double c[9], det, inv, y0, y1, y2;
+    c[0] = a[4] * a[8] - a[5] * a[7], c[1] = a[5] * a[6] - a[3] * a[8];
+    c[2] = a[3] * a[7] - a[4] * a[6], c[3] = a[7] * a[2] - a[8] * a[1];
+    c[4] = a[8] * a[0] - a[6] * a[2], c[5] = a[6] * a[1] - a[7] * a[0];
+    c[6] = a[1] * a[5] - a[2] * a[4], c[7] = a[2] * a[3] - a[0] * a[5];
+    c[8] = a[0] * a[4] - a[1] * a[3];
+    det = a[0] * c[0] + a[1] * c[1] + a[2] * c[2];
+    if (!(det * det > 1e-24 * (a[0] * a[0] + a[1] * a[1] + a[2] * a[2])
+                          * (a[3] * a[3] + a[4] * a[4] + a[5] * a[5])
+                          * (a[6] * a[6] + a[7] * a[7] + a[8] * a[8]))) {
         return -1;
     }
-    for (i = 0; i < 3; ++i) {
-        y[i] = 0.0;
-        for (j = 0; j < 3; ++j) {
-            y[i] += (transpose ? cof[3 * i + j] : cof[3 * j + i]) * b[j];
-        }
+    if (transpose) { /* A^-T = C / det */
+        y0 = c[0] * b[0] + c[1] * b[1] + c[2] * b[2];
+        y1 = c[3] * b[0] + c[4] * b[1] + c[5] * b[2];
+        y2 = c[6] * b[0] + c[7] * b[1] + c[8] * b[2];
+    } else { /* A^-1 = C^T / det */
+        y0 = c[0] * b[0] + c[3] * b[1] + c[6] * b[2];
+        y1 = c[1] * b[0] + c[4] * b[1] + c[7] * b[2];
+        y2 = c[2] * b[0] + c[5] * b[1] + c[8] * b[2];
     }
-    for (i = 0; i < 3; ++i) {
-        x[i] = y[i] / det;
-    }
+    inv = 1.0 / det;
+    x[0] = y0 * inv, x[1] = y1 * inv, x[2] = y2 * inv;
     return 0;
 }
 
@@ -198,15 +201,16 @@ struct controller {
     double qd[3];         /* velocity estimate */
     double tau[3];        /* the efforts commanded */
     long failed_fk, failed_jacobian, failed_dynamics;
-    double fk_ns, dynamics_ns; /* latencies of this tick's calls */
 };
 
-/* One tick: encoder counts at time t in, ctl->tau out. */
-static void controller_tick(struct controller *ctl, const long *counts, double t)
+/* One tick: encoder counts at time t in, ctl->tau out; ns[0..3) the latencies of its forward
+ * kinematics, of the rest and of the whole tick (three clock readings, one inside the tick). */
+static void controller_tick(struct controller *ctl, const long *counts, double t, double *ns)
 {
     const double dt = 1.0 / RATE_HZ;
+    const double start = now_ns();
     double qa[3], near[3], q[3], J[9], M[9], c[3], f[3], q_d[3], qd_d[3], qdd_d[3], acc[3];
-    double start;
+    double fk_end;
     const int first = !ctl->started;
     int status, i, k;
 
@@ -221,9 +225,10 @@ static void controller_tick(struct controller *ctl, const long *counts, double t
     }
     ctl->started = 1;
 
-    start = now_ns(); /* the pose: tracked forward kinematics from the prediction */
+    /* the pose: tracked forward kinematics from the prediction */
     status = rpr3_forward_kinematics(ctl->params, qa, near, q);
-    ctl->fk_ns = now_ns() - start;
+    fk_end = now_ns();
+    ns[0] = fk_end - start;
     if (status != RPR3_OK) {
         ++ctl->failed_fk;
         memcpy(q, near, sizeof q); /* coast on the prediction */
@@ -234,7 +239,8 @@ static void controller_tick(struct controller *ctl, const long *counts, double t
     if (rpr3_actuator_jacobian(ctl->params, q, J) != RPR3_OK
         || solve3(J, ctl->rate, 0, ctl->qd) != 0) { /* the velocity: J q' = qa' */
         ++ctl->failed_jacobian;
-        ctl->dynamics_ns = 0.0;
+        ns[2] = now_ns() - start;
+        ns[1] = ns[2] - ns[0];
         return; /* hold the last efforts */
     }
 
@@ -242,7 +248,7 @@ static void controller_tick(struct controller *ctl, const long *counts, double t
     for (k = 0; k < 3; ++k) {
         acc[k] = qdd_d[k] + KD * (qd_d[k] - ctl->qd[k]) + KP * (q_d[k] - q[k]);
     }
-    start = now_ns(); /* computed torque in task space: J^T tau = M acc + c */
+    /* computed torque in task space: J^T tau = M acc + c */
     status = rpr3_task_space_dynamics(ctl->params, q, ctl->qd, M, c);
     if (status == RPR3_OK) {
         for (i = 0; i < 3; ++i) {
@@ -253,10 +259,57 @@ static void controller_tick(struct controller *ctl, const long *counts, double t
         }
         status = solve3(J, f, 1, ctl->tau);
     }
-    ctl->dynamics_ns = now_ns() - start;
     if (status != RPR3_OK) {
         ++ctl->failed_dynamics;
     }
+    ns[2] = now_ns() - start;
+    ns[1] = ns[2] - (fk_end - start);
+}
+
+/* control_loop.py's arguments: --params FILE, --trajectory NAME (or NAME alone), --seconds T,
+ * --offset MM, each as "--name value" or "--name=value". Returns 0, or -1 on a bad argument. */
+static int parse_arguments(int argc, char **argv, const char **params, const char **trajectory,
+                           double *seconds, double *offset)
+{
+    const char *options[] = {"--params", "--trajectory", "--seconds", "--offset"};
+    int a, k, positional = 0;
+    for (a = 1; a < argc; ++a) {
+        const char *value = NULL;
+        char *end;
+        if (strncmp(argv[a], "--", 2) != 0) { /* the trajectory, positional */
+            if (positional++) {
+                return -1;
+            }
+            *trajectory = argv[a];
+            continue;
+        }
+        for (k = 0; k < 4; ++k) {
+            const size_t n = strlen(options[k]);
+            if (strncmp(argv[a], options[k], n) == 0 && argv[a][n] == '=') {
+                value = argv[a] + n + 1;
+                break;
+            }
+            if (strcmp(argv[a], options[k]) == 0 && a + 1 < argc) {
+                value = argv[++a];
+                break;
+            }
+        }
+        if (value == NULL) {
+            return -1;
+        }
+        if (k == 0) {
+            *params = value;
+        } else if (k == 1) {
+            *trajectory = value;
+        } else {
+            const double number = strtod(value, &end);
+            if (*end != '\0' || end == value) {
+                return -1;
+            }
+            *(k == 2 ? seconds : offset) = number;
+        }
+    }
+    return 0;
 }
 
 static int compare(const void *a, const void *b)
@@ -291,12 +344,12 @@ int main(int argc, char **argv)
     double nominal[RPR3_NUM_PARAMS], truth[RPR3_NUM_PARAMS];
     const char *perturbed[] = {"m1", "m2", "m3", "J1", "J2", "J3"};
     const double factor[] = {1.03, 0.96, 1.05, 1.04, 0.97, 1.05};
-    const char *name = argc > 2 ? argv[2] : "rectilinear";
-    const double seconds = argc > 3 ? atof(argv[3]) : DURATION;
-    const double offset = argc > 4 ? atof(argv[4]) : 0.0; /* mm */
+    const char *name = "rectilinear", *params_file = "paper.params";
+    double seconds = DURATION, offset = 0.0; /* s, mm */
     const int revolute = strcmp(RPR3_ACTUATION, "revolute") == 0;
     const double dt = 1.0 / RATE_HZ;
-    const long steps = (long)(seconds * RATE_HZ + 0.5), transient = (long)(TRANSIENT * RATE_HZ + 0.5);
+    long steps;
+    const long transient = (long)(TRANSIENT * RATE_HZ + 0.5);
     const char *unit = revolute ? "N m" : "N";
     struct controller ctl;
     struct stats after = {{0.0, 0.0}, {0.0, 0.0}, 0}, overall = after, estimate = after;
@@ -306,11 +359,13 @@ int main(int argc, char **argv)
     long step, counts[3];
     int k;
 
-    if (argc < 2 || argc > 5 || read_params(argv[1], nominal) < 0) {
-        fprintf(stderr, "usage: control_loop PARAMS_FILE [rectilinear|rotation] [SECONDS] "
-                        "[OFFSET_MM]\n");
+    if (parse_arguments(argc, argv, &params_file, &name, &seconds, &offset) != 0
+        || read_params(params_file, nominal) < 0) {
+        fprintf(stderr, "usage: control_loop [--params FILE] [--trajectory rectilinear|rotation] "
+                        "[--seconds T] [--offset MM] [rectilinear|rotation]\n");
         return 2;
     }
+    steps = (long)(seconds * RATE_HZ + 0.5);
     memset(&ctl, 0, sizeof ctl);
     if (strcmp(name, "rectilinear") == 0) {
         ctl.amplitude[0] = 0.05, ctl.amplitude[1] = -0.05, ctl.amplitude[2] = 0.0;
@@ -340,17 +395,16 @@ int main(int argc, char **argv)
 
     for (step = 0; step < steps; ++step) {
         const double t = step * dt;
-        double start, q_d[3], qd_d[3], qdd_d[3], dq[3];
+        double ns[3], q_d[3], qd_d[3], qdd_d[3], dq[3];
         if (encoders(truth, q, ctl.resolution, counts) != 0) {
             fprintf(stderr, "control_loop: the plant reached a singular pose at t = %g s\n", t);
             free(latency);
             return 1;
         }
-        start = now_ns();
-        controller_tick(&ctl, counts, t);
-        latency[2 * steps + step] = now_ns() - start;
-        latency[step] = ctl.fk_ns;
-        latency[steps + step] = ctl.dynamics_ns;
+        controller_tick(&ctl, counts, t, ns);
+        latency[step] = ns[0];
+        latency[steps + step] = ns[1];
+        latency[2 * steps + step] = ns[2];
 
         for (k = 0; k < 3; ++k) {
             dq[k] = ctl.qd[k] - qd[k];
@@ -408,7 +462,7 @@ int main(int argc, char **argv)
     printf("failed calls: forward kinematics %ld, jacobian %ld, dynamics %ld\n", ctl.failed_fk,
            ctl.failed_jacobian, ctl.failed_dynamics);
     print_latency("forward kinematics", latency, steps);
-    print_latency("dynamics", latency + steps, steps);
+    print_latency("rest of the tick", latency + steps, steps);
     print_latency("whole tick", latency + 2 * steps, steps);
     free(latency);
     return ctl.failed_fk || ctl.failed_jacobian || ctl.failed_dynamics ? 1 : 0;

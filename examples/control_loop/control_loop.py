@@ -6,12 +6,16 @@ actuator positions, estimates the actuator rates from the differences of the cou
 filtered), reconstructs the pose by tracked forward kinematics and the velocity through the
 actuator Jacobian, and commands tau = J^-T (M (qdd_d + Kd e' + Kp e) + c) from the nominal
 model's task-space dynamics. Every generated function is called through
-rpr3gen.SampleEvaluator (the generated C, preallocated buffers). Prints the tracking error, the
-failed calls and the latency (p50, p99, max) of the forward kinematics, the dynamics and the
-whole controller tick.
+rpr3gen.SampleEvaluator (the generated C, preallocated buffers); the tick's own arithmetic is on
+Python floats (a NumPy operation on a 3-vector costs more than the C it feeds). Prints the
+tracking error, the failed calls and the latency (p50, p99, max) of the forward kinematics, of
+the rest of the tick and of the whole controller tick.
 
-    python control_loop.py [--model FILE] [--actuation revolute|prismatic]
-                           [--trajectory rectilinear|rotation] [--seconds T] [--offset MM]
+The arguments are control_loop.c's, plus --model and --actuation (the C program's are its build):
+
+    python control_loop.py [--params FILE] [--trajectory rectilinear|rotation] [--seconds T]
+                           [--offset MM] [--model FILE] [--actuation revolute|prismatic]
+                           [rectilinear|rotation]
 """
 
 from __future__ import annotations
@@ -39,11 +43,8 @@ PERTURBED = {"m1": 1.03, "m2": 0.96, "m3": 1.05, "J1": 1.04, "J2": 0.97, "J3": 1
 def reference(amplitude: np.ndarray, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Paper eq. (3), q = q* (1 - cos(pi t / T)), and its first two derivatives."""
     w = math.pi / DURATION
-    return (
-        amplitude * (1.0 - math.cos(w * t)),
-        amplitude * (w * math.sin(w * t)),
-        amplitude * (w * w * math.cos(w * t)),
-    )
+    c, s = math.cos(w * t), math.sin(w * t)
+    return amplitude * (1.0 - c), amplitude * (w * s), amplitude * (w * w * c)
 
 
 class Plant:
@@ -79,12 +80,13 @@ class Plant:
             qd = qd + h / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4)
         self.q, self.qd = q, qd
 
-    def encoders(self) -> np.ndarray:
+    def encoders(self) -> tuple[int, int, int]:
         """The encoder counts: the actuator coordinates rounded to whole counts."""
         self.coordinates.q[:] = self.q
         if self.coordinates():
             raise RuntimeError(f"the plant reached a singular pose, q = {self.q.tolist()}")
-        return np.rint(self.coordinates.qa / self.resolution)
+        a, b, c = np.rint(self.coordinates.qa / self.resolution).tolist()
+        return int(a), int(b), int(c)
 
 
 class Controller:
@@ -95,62 +97,70 @@ class Controller:
         # computed-torque law are generated too, so the tick does no 3 x 3 algebra in Python:
         # platform_velocity solves J qd = qa'; actuator_efforts at the commanded acceleration a
         # is tau = J^-T (M a + c) (the C program writes that law out with task_space_dynamics).
+        # They share buffers: the pose the forward kinematics writes is the q the other two
+        # read, the velocity platform_velocity writes is the qd actuator_efforts reads.
         self.fk = rpr3gen.SampleEvaluator(model, function="forward_kinematics")
-        self.velocity = rpr3gen.SampleEvaluator(model, function="platform_velocity")
-        self.efforts = rpr3gen.SampleEvaluator(model, function="actuator_efforts")
-        self.resolution, self.amplitude = resolution, amplitude
+        self.velocity = rpr3gen.SampleEvaluator(
+            model, function="platform_velocity", buffers={"q": self.fk.q}
+        )
+        self.efforts = rpr3gen.SampleEvaluator(
+            model, function="actuator_efforts", buffers={"q": self.fk.q, "qd": self.velocity.qd}
+        )
+        self.resolution, self.amplitude = resolution, amplitude.tolist()
         self.alpha = 1.0 - math.exp(-2.0 * math.pi * RATE_CUTOFF_HZ / RATE_HZ)
-        self.q1 = np.zeros(3)  # the last two pose estimates; the robot was parked at home
-        self.q2 = np.zeros(3)
-        self.counts: np.ndarray | None = None
-        self.rate = np.zeros(3)  # filtered actuator rates
-        self.qd = np.zeros(3)
-        self.tau = np.zeros(3)
+        self.q1 = [0.0, 0.0, 0.0]  # the last two pose estimates; the robot was parked at home
+        self.q2 = [0.0, 0.0, 0.0]
+        self.counts: tuple[int, int, int] | None = None
+        self.rate = [0.0, 0.0, 0.0]  # filtered actuator rates
+        self.qd = [0.0, 0.0, 0.0]
+        self.tau = [0.0, 0.0, 0.0]
         self.failed = {"forward kinematics": 0, "jacobian": 0, "dynamics": 0}
-        self.latency = {"forward kinematics": 0, "dynamics": 0}
+        self.latency = [0, 0, 0]  # ns: forward kinematics, the rest, the whole tick
 
-    def tick(self, counts: np.ndarray, t: float) -> np.ndarray:
+    def tick(self, counts: tuple[int, int, int], t: float) -> list[float]:
+        """Encoder counts at time t in, efforts out; latencies in :attr:`latency`."""
         clock = time.perf_counter_ns
-        dt = 1.0 / RATE_HZ
+        start = clock()
+        res = self.resolution
         # actuator positions and rates from the counts
-        qa = counts * self.resolution
+        fk = self.fk
+        fk.qa[:] = (counts[0] * res, counts[1] * res, counts[2] * res)
         first = self.counts is None
         if not first:
-            raw = (counts - self.counts) * (self.resolution / dt)
-            self.rate += self.alpha * (raw - self.rate)
+            scale, alpha, old = res * RATE_HZ, self.alpha, self.counts
+            self.rate = [r + alpha * ((c - o) * scale - r)
+                         for r, c, o in zip(self.rate, counts, old, strict=True)]  # fmt: skip
         self.counts = counts
         # the pose: tracked forward kinematics from the constant-velocity prediction
-        fk = self.fk
-        fk.qa[:] = qa
-        fk.q_near[:] = 2.0 * self.q1 - self.q2
-        start = clock()
+        q1, q2 = self.q1, self.q2
+        near = (2.0 * q1[0] - q2[0], 2.0 * q1[1] - q2[1], 2.0 * q1[2] - q2[2])
+        fk.q_near[:] = near
         status = fk()
-        self.latency["forward kinematics"] = clock() - start
+        fk_end = clock()
         if status:
             self.failed["forward kinematics"] += 1
-            fk.q[:] = fk.q_near  # coast on the prediction
-        q = fk.q.copy()
-        self.q2, self.q1 = (q if first else self.q1), q  # at first, at rest
+            fk.q[:] = near  # coast on the prediction
+        q = fk.q.tolist()
+        self.q2, self.q1 = (q if first else q1), q  # at first, at rest
         # the velocity: J qd = qa' (the "jacobian" count is this solve's failures)
         vel = self.velocity
-        vel.q[:], vel.qa_dot[:] = q, self.rate
+        vel.qa_dot[:] = self.rate
         if vel():
             self.failed["jacobian"] += 1
-            self.latency["dynamics"] = 0
-            return self.tau  # hold the last efforts
-        self.qd = vel.qd.copy()
-        # computed torque in task space: tau = J^-T (M (qdd_d + Kd e' + Kp e) + c)
-        q_d, qd_d, qdd_d = reference(self.amplitude, t)
-        eff = self.efforts
-        eff.q[:], eff.qd[:] = q, self.qd
-        eff.qdd[:] = qdd_d + KD * (qd_d - self.qd) + KP * (q_d - q)
-        start = clock()
-        status = eff()
-        self.latency["dynamics"] = clock() - start
-        if status:
-            self.failed["dynamics"] += 1
         else:
-            self.tau = eff.tau.copy()
+            self.qd = qd = vel.qd.tolist()
+            # computed torque in task space: tau = J^-T (M (qdd_d + Kd e' + Kp e) + c)
+            w = math.pi / DURATION
+            c, s = math.cos(w * t), math.sin(w * t)
+            eff = self.efforts
+            eff.qdd[:] = [a * (w * w * c) + KD * (a * (w * s) - v) + KP * (a * (1.0 - c) - x)
+                          for a, v, x in zip(self.amplitude, qd, q, strict=True)]  # fmt: skip
+            if eff():
+                self.failed["dynamics"] += 1
+            else:
+                self.tau = eff.tau.tolist()
+        end = clock()
+        self.latency = [fk_end - start, end - fk_end, end - start]
         return self.tau
 
 
@@ -165,18 +175,27 @@ def main() -> int:
     parser.add_argument("--model", help="model file (default: the paper robot)")
     parser.add_argument("--actuation", choices=["revolute", "prismatic"],
                         help="override the model's actuation")  # fmt: skip
-    parser.add_argument("--trajectory", choices=sorted(rpr3gen.trajectory.PAPER_TRAJECTORIES),
-                        default="rectilinear")  # fmt: skip
+    trajectories = sorted(rpr3gen.trajectory.PAPER_TRAJECTORIES)
+    parser.add_argument("--trajectory", choices=trajectories, default="rectilinear")
     parser.add_argument("--seconds", type=float, default=DURATION)
     parser.add_argument("--offset", type=float, default=0.0, metavar="MM",
                         help="start the plant MM millimetres off in x and -MM in y")  # fmt: skip
+    parser.add_argument("--params", metavar="FILE",
+                        help="numbers as `rpr3gen params` writes them")  # fmt: skip
+    parser.add_argument("positional", nargs="?", choices=trajectories, metavar="TRAJECTORY",
+                        help="the trajectory, as --trajectory")  # fmt: skip
     args = parser.parse_args()
     if not args.seconds > 0:
         parser.error("--seconds must be positive")
+    args.trajectory = args.positional or args.trajectory
 
     model = rpr3gen.load_model(args.model)
     if args.actuation:
         model = dataclasses.replace(model, actuation=args.actuation)
+    if args.params:
+        with open(args.params, encoding="utf-8") as handle:
+            given = {name: float(value) for name, value in (line.split() for line in handle)}
+        model = dataclasses.replace(model, params={**model.params, **given})
     truth = dataclasses.replace(
         model, params={k: v * PERTURBED.get(k, 1.0) for k, v in model.params.items()}
     )
@@ -193,15 +212,12 @@ def main() -> int:
     estimate = np.empty((steps, 2))  # pose estimate vs plant, at each tick's reading
     velocity = np.empty((steps, 3))  # velocity estimate vs plant
     efforts = np.empty((steps, 3))
-    clock = time.perf_counter_ns
     for step in range(steps):
         t = step * dt
         counts = plant.encoders()
-        start = clock()
         tau = controller.tick(counts, t)
-        latency[step, 2] = clock() - start
-        latency[step, :2] = list(controller.latency.values())
-        d = controller.q1 - plant.q
+        latency[step] = controller.latency
+        d = np.array(controller.q1) - plant.q
         estimate[step] = math.hypot(d[0], d[1]), abs(d[2])
         velocity[step] = controller.qd - plant.qd
         efforts[step] = tau
@@ -240,7 +256,7 @@ def main() -> int:
         f"max {change.max() if len(change) else 0.0:.4f} {unit}"
     )
     print("failed calls: " + ", ".join(f"{k} {v}" for k, v in controller.failed.items()))
-    for k, label in enumerate(("forward kinematics", "dynamics", "whole tick")):
+    for k, label in enumerate(("forward kinematics", "rest of the tick", "whole tick")):
         p50, p99, worst = percentiles(latency[:, k])
         print(
             f"latency {label}: p50 {p50 / 1e3:.2f} us, p99 {p99 / 1e3:.2f} us, "

@@ -7,12 +7,15 @@
 >>> torque = ev.out[ev.index["m10_A"]]
 
 Any generated function can be bound the same way by name (``function="..."``): its inputs and
-outputs become attributes named as in the manifest.
+outputs become attributes named as in the manifest. Evaluators can share buffers
+(``buffers={"q": fk.q}``), so that one function's output is another's input with no copy: a
+control tick then moves no data between its generated calls.
 """
 
 from __future__ import annotations
 
 import ctypes
+from collections.abc import Mapping
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -21,7 +24,7 @@ from rpr3gen import policy, variants
 from rpr3gen.errors import InputError, Rpr3genError
 from rpr3gen.evaluators import evaluator
 from rpr3gen.model import Model
-from rpr3gen.validation import Instance, Reading, checked
+from rpr3gen.validation import Instance, Optional, Reading, checked
 
 
 class SampleEvaluator:
@@ -34,10 +37,22 @@ class SampleEvaluator:
     position). With the ``c`` backend a call makes no allocation: the generated C is called
     with pointers fixed at construction. On a non-zero return code the outputs are left as they
     were; :attr:`codes` maps each code to its meaning (from the manifest).
+
+    ``buffers`` maps input or output names to arrays to use as those buffers instead of new ones
+    (float64, C-contiguous, of the argument's size), e.g. another evaluator's output.
     """
 
-    @checked(function=Instance(str, "the name of a generated function"))
-    def __init__(self, model: Model, backend: str = "c", function: str = "inverse_dynamics"):
+    @checked(
+        function=Instance(str, "the name of a generated function"),
+        buffers=Optional(Instance(Mapping, "a mapping of argument names to float64 buffers")),
+    )
+    def __init__(
+        self,
+        model: Model,
+        backend: str = "c",
+        function: str = "inverse_dynamics",
+        buffers: Mapping[str, np.ndarray] | None = None,
+    ):
         self.model = model
         self.backend = backend
         variant = variants.load(model.structure, model.generated)
@@ -50,16 +65,24 @@ class SampleEvaluator:
         self.function = variant.function(function)
         self.codes = dict(variant.code_meanings)
         self.params = np.ascontiguousarray(model.vector(variant.param_names))
-        self.inputs = {a.name: np.zeros(a.size) for a in self.function.inputs}
-        self.outputs = {o.name: np.full(o.size, np.nan) for o in self.function.public_outputs}
+        given = dict(buffers or {})
+        self.inputs = {
+            a.name: _buffer(given, a.name, np.zeros(a.size)) for a in self.function.inputs
+        }
+        self.outputs = {
+            o.name: _buffer(given, o.name, np.full(o.size, np.nan))
+            for o in self.function.public_outputs
+        }
+        if given:
+            raise InputError(f"{function}: no input or output named {sorted(given)}")
         for name, buffer in (*self.inputs.items(), *self.outputs.items()):
             setattr(self, name, buffer)
         first = self.function.outputs[0]
         self.index = {name: k for k, name in enumerate(first.names)}
         ev = evaluator(variant, backend)  # also checks the backend's name
         if backend == "c":
-            buffers = [self.params, *self.inputs.values(), *self.outputs.values()]
-            self._pointers = (ctypes.c_void_p * len(buffers))(*(b.ctypes.data for b in buffers))
+            arrays = [self.params, *self.inputs.values(), *self.outputs.values()]
+            self._pointers = (ctypes.c_void_p * len(arrays))(*(b.ctypes.data for b in arrays))
             self._args = (ctypes.c_void_p(ctypes.addressof(self._pointers)),)
             self._call = ev.library.entries[self.function.name].packed  # type: ignore[attr-defined]
         else:
@@ -93,3 +116,16 @@ class SampleEvaluator:
                 f"sample {first}={self.inputs[first].tolist()}: {self.codes.get(status, status)}"
             )
         return next(iter(self.outputs.values()))
+
+
+def _buffer(given: dict[str, np.ndarray], name: str, default: np.ndarray) -> np.ndarray:
+    """``given[name]`` (removed from ``given``) checked to replace ``default``, else ``default``."""
+    if name not in given:
+        return default
+    buffer = given.pop(name)
+    ok = isinstance(buffer, np.ndarray) and buffer.dtype == np.float64
+    if not (ok and buffer.shape == default.shape and buffer.flags.c_contiguous):
+        raise InputError(
+            f"buffer {name!r}: need a C-contiguous float64 array of shape {default.shape}"
+        )
+    return buffer

@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING, Any
 import jinja2
 from rpr3gen_derive.codegen import mathkernels
 from rpr3gen_derive.codegen.backends.c.batch import NotSplittableError, plan
+from rpr3gen_derive.codegen.backends.c.order import Line, schedule
 from rpr3gen_derive.codegen.backends.c.printer import c_code, fast_trig_arguments
 from rpr3gen_derive.codegen.spec import ModuleSpec
 
@@ -53,8 +54,45 @@ def _lines(statements: Any, prefix: str, fast: bool = False) -> list[tuple[str, 
     return [(str(lhs), c_code(rhs, prefix, fast)) for lhs, rhs in statements]
 
 
-def _function(module: ModuleSpec, c: Compiled) -> dict[str, Any]:
-    """Template context of one function."""
+def _kernel_lines(
+    c: Compiled, prefix: str, outputs: list[tuple[str, int, str]], public_only: bool = False
+) -> list[Line]:
+    """The single-sample kernel's loads, assignments and output stores, scheduled
+    (:func:`.order.schedule`) so that few values are live at once; ``public_only``: the stores
+    of the public outputs and what they need, nothing else (the values-only kernel)."""
+
+    def names(expr: Any) -> frozenset[str]:
+        return frozenset(str(s) for s in expr.free_symbols)
+
+    none: frozenset[str] = frozenset()
+    lines = [Line("load", name, none, (f"params[{k}]",)) for k, name in c.used_params]
+    lines += [Line("load", name, none, (f"{arg}[{k}]",)) for arg, k, name in c.used_inputs]
+    lines += [Line("assign", str(lhs), names(rhs), (c_code(rhs, prefix),))
+              for lhs, rhs in c.code.assignments]  # fmt: skip
+    stored = zip(outputs, c.code.outputs, strict=True)
+    lines += [Line("store", "", names(e), (out, str(index), text))
+              for (out, index, text), (_, e) in stored]  # fmt: skip
+    if public_only:
+        hidden = {o.name for o in c.spec.outputs if o not in c.spec.public_outputs}
+        lines = _needed([x for x in lines if x.kind != "store" or x.payload[0] not in hidden])
+    return schedule(lines)
+
+
+def _needed(lines: list[Line]) -> list[Line]:
+    """The stores of ``lines`` and the lines they read, transitively, in order."""
+    defined = {x.name: x for x in lines if x.name}
+    wanted = {x.name for x in lines if x.kind == "store"}
+    pending = [r for x in lines if x.kind == "store" for r in x.reads]
+    while pending:
+        name = pending.pop()
+        if name in defined and name not in wanted:
+            wanted.add(name)
+            pending.extend(defined[name].reads)
+    return [x for x in lines if x.kind == "store" or x.name in wanted]
+
+
+def _function(module: ModuleSpec, c: Compiled, values: bool = False) -> dict[str, Any]:
+    """Template context of one function; ``values``: with its values-only kernel too."""
     from rpr3gen_derive.codegen.render import table_count
 
     prefix, spec = module.prefix, c.spec
@@ -82,6 +120,8 @@ def _function(module: ModuleSpec, c: Compiled) -> dict[str, Any]:
     kernel = ["const double *restrict params"]
     kernel += [f"const double *restrict {a.name}" for a in spec.inputs]
     kernel += [f"double *restrict r_{o.name}" for o in spec.outputs]
+    values_params = kernel[: 1 + len(spec.inputs)]
+    values_params += [f"double *restrict r_{o.name}" for o in spec.public_outputs]
     checks = []
     input_code = None
     custom_code = None
@@ -115,7 +155,13 @@ def _function(module: ModuleSpec, c: Compiled) -> dict[str, Any]:
         "used_params": c.used_params,
         "used_inputs": c.used_inputs,
         "assignments": _lines(c.code.assignments, prefix),
-        "outputs": outputs(enumerate(e for _, e in c.code.outputs)),
+        "kernel_lines": _kernel_lines(c, prefix, outputs(enumerate(e for _, e in c.code.outputs))),
+        "values_lines": (
+            _kernel_lines(c, prefix, outputs(enumerate(e for _, e in c.code.outputs)), True)
+            if values
+            else None
+        ),
+        "values_signature": signature(f"static void {name}_values", values_params),
         "input_code": input_code,
         "custom_code": custom_code,
         "checks": checks,
@@ -157,7 +203,8 @@ def render(
     from rpr3gen_derive.codegen.render import table_count
 
     with stage("print"):
-        functions = [_function(module, c) for c in compiled]
+        values = {name for c in compiled for name in c.spec.c_values}
+        functions = [_function(module, c, c.spec.name in values) for c in compiled]
     tables = [(table_count(module.params.table or "param_names"), module.params)]
     tables += [(table_count(str(t.table)), t) for t in module.tables]
     for c in compiled:
@@ -166,6 +213,7 @@ def render(
     kernels = mathkernels.used(
         e for c in compiled for e in [rhs for _, rhs in c.code.assignments + c.code.outputs]
     )
+    kernels |= {k for c in compiled for k in c.spec.c_kernels}
     context = {
         "module": module,
         "functions": functions,

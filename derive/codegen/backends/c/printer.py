@@ -7,7 +7,10 @@ calls of the generated C's own inline kernels (:mod:`rpr3gen_derive.codegen.math
 ``{prefix}_sin`` etc., so that loops over samples vectorise. In the batch loops
 (``fast=True``) ``sin`` and ``cos`` are the kernels' fast path (``{prefix}_sin_fast``), valid
 below ``mathkernels.FAST_LIMIT``; the batch flags larger arguments
-(:func:`fast_trig_arguments`).
+(:func:`fast_trig_arguments`). A product with several reciprocals, ``x/a/b/c``, is printed as
+one division ``x/(a*b*c)`` (SymPy prints ``x*1.0/a*1.0/b*1.0/c``): divisions and square roots
+share one unit of the processor, slow and long, so one division in place of three shortens
+both the throughput and the dependency chain (the conditioning of every function has one).
 """
 
 from __future__ import annotations
@@ -18,6 +21,7 @@ import sympy as sp
 from rpr3gen_derive.codegen.backends import prepare
 from rpr3gen_derive.codegen.functions import INV_TWO_PI, TWO_PI
 from sympy.printing.c import C99CodePrinter
+from sympy.printing.precedence import precedence
 
 
 class CPrinter(C99CodePrinter):
@@ -41,6 +45,18 @@ class CPrinter(C99CodePrinter):
         # x - 2 pi round(x / 2 pi): a few flops, where glibc's remainder() costs ~40 ns.
         x = self._print(expr.args[0])
         return f"(({x}) - {TWO_PI}*{self.prefix}_rint(({x})*{INV_TWO_PI}))"
+
+    def _print_Mul(self, expr: sp.Expr) -> str:
+        def reciprocal(f: sp.Expr) -> bool:
+            return bool(f.is_Pow and f.exp == -1)
+
+        below = [f.base for f in expr.args if reciprocal(f)]
+        if len(below) < 2:
+            return str(super()._print_Mul(expr))
+        above = [f for f in expr.args if not reciprocal(f)]
+        numerator = self._print(sp.Mul(*above)) if above else "1.0"
+        denominator = "*".join(self.parenthesize(b, precedence(expr)) for b in below)
+        return f"{numerator}/({denominator})"
 
     def _fold(self, name: str, expr: sp.Expr) -> str:
         args = [self._print(a) for a in expr.args]

@@ -1,0 +1,64 @@
+"""The control-loop examples as benchmarks: their own tick latencies (issue 20's figure).
+
+``examples/control_loop`` is built by its Makefile (its flags, against ``generated/``) into a
+temporary folder, and both programs, C and Python, run every variant the Makefile builds on both
+paper trajectories for 3 s; each prints the latency (p50, p99, max) of its forward kinematics,
+of the rest of the tick and of the whole tick, which are parsed here.
+"""
+
+from __future__ import annotations
+
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+from typing import Any
+
+from harness import samples
+
+EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "control_loop"
+TRAJECTORIES = ("rectilinear", "rotation")
+LATENCY = re.compile(r"latency (.+): p50 ([\d.]+) (ns|us), p99 ([\d.]+) \3, max ([\d.]+) \3")
+
+
+def parse(text: str) -> dict[str, dict[str, float]]:
+    """``{"whole tick": {"p50": ns, "p99": ns, "max": ns}, ...}`` from a program's report."""
+    found = {}
+    for label, p50, unit, p99, worst in LATENCY.findall(text):
+        scale = 1e3 if unit == "us" else 1.0
+        found[label] = {"p50": float(p50) * scale, "p99": float(p99) * scale,
+                        "max": float(worst) * scale}  # fmt: skip
+    return found
+
+
+def run() -> dict[str, Any]:
+    """Latencies by language, variant and trajectory, with the C build's flags."""
+    results: dict[str, Any] = {"c": {}, "python": {}}
+    with tempfile.TemporaryDirectory(prefix="rpr3bench-loop-") as tmp:
+        work = Path(tmp)
+        for name in ("Makefile", "control_loop.c"):
+            shutil.copy(EXAMPLE / name, work / name)
+        generated = Path(samples.manifest.default_folder())
+        made = subprocess.run(["make", "-s", f"GENERATED={generated}", "-n"], cwd=work,
+                              capture_output=True, text=True, check=True)  # fmt: skip
+        results["build"] = made.stdout.splitlines()[0] if made.stdout else ""
+        subprocess.run(["make", "-s", f"GENERATED={generated}"], cwd=work, check=True)
+        params = subprocess.run([sys.executable, "-m", "rpr3gen.cli", "params"],
+                                capture_output=True, text=True, check=True)  # fmt: skip
+        (work / "paper.params").write_text(params.stdout)
+        for variant in samples.variants():
+            binary = work / f"control_loop_{variant}"
+            for trajectory in TRAJECTORIES:
+                key = f"{variant}/{trajectory}"
+                if binary.exists():
+                    done = subprocess.run([str(binary), trajectory], cwd=work,
+                                          capture_output=True, text=True, check=True)  # fmt: skip
+                    results["c"][key] = parse(done.stdout)
+                done = subprocess.run(
+                    [sys.executable, str(EXAMPLE / "control_loop.py"), "--actuation", variant,
+                     trajectory], cwd=work, capture_output=True, text=True, check=True,
+                )  # fmt: skip
+                results["python"][key] = parse(done.stdout)
+    return results

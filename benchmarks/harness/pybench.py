@@ -1,0 +1,203 @@
+"""The Python benchmarks, on pyperf: ``python harness/pybench.py GROUP -o FILE.json``.
+
+pyperf runs each benchmark in fresh worker processes, calibrates the loop count, discards
+warm-ups and records the machine (CPU, load average, versions) with every value; this script
+only says what to time. Each benchmark is a pyperf *time function* whose setup (samples,
+evaluators) happens before its clock starts. Groups (one pyperf run each, so that each has its
+own repeat counts):
+
+- ``numpy``: ``rpr3gen.evaluate(model, "inverse_dynamics", ..., backend="numpy")`` and the
+  independent Newton-Euler solver (``tests/newton_euler.py``, in chunks of 10^5 samples so that
+  its (n, 21, 21) systems fit) on the same samples, per variant and motion, at 10^4 and 10^5;
+- ``large``: the same at 10^6 (a call takes seconds: run with ``--loops 1``);
+- ``functions``: ``evaluate(..., backend="numpy")`` of every measurable function at 10^5;
+- ``calls``: ``SampleEvaluator`` single calls (the C through ctypes) of every function, at the
+  generic motion's first pose, and the same call with a NaN input (the ctypes floor);
+- ``peers``: MuJoCo's ``mj_forward`` on the same robot (skipped without MuJoCo);
+- ``regen``: ``rpr3gen generate --check``, a fresh interpreter end to end.
+
+Benchmark names are ``group/variant/...`` (see :func:`names`); ``benchmarks/run.py`` reads them.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import math
+import sys
+import time
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pyperf
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+import rpr3gen
+from harness import samples
+from rpr3gen import manifest
+
+REPO = Path(__file__).resolve().parents[2]
+SIZES = {"numpy": (10**4, 10**5), "large": (10**6,)}
+NE_CHUNK = 10**5
+GROUPS = ("numpy", "large", "functions", "calls", "peers", "regen")
+
+
+def test_module(name: str) -> Any:
+    """``tests/NAME.py``, imported by path (the tests are no package)."""
+    spec = importlib.util.spec_from_file_location(
+        f"rpr3bench_{name}", REPO / "tests" / f"{name}.py"
+    )
+    assert spec is not None
+    assert spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module  # dataclasses look their module up
+    spec.loader.exec_module(module)
+    return module
+
+
+def timed(setup: Callable[[], Callable[[], object]]) -> Callable[[int], float]:
+    """A pyperf time function: ``setup()`` (untimed, once per worker) returns the call to time."""
+    made: list[Callable[[], object]] = []
+
+    def run(loops: int) -> float:
+        if not made:
+            made.append(setup())
+        call = made[0]
+        start = time.perf_counter()
+        for _ in range(loops):
+            call()
+        return time.perf_counter() - start
+
+    return run
+
+
+def numpy_benchmarks(variant: str, sizes: tuple[int, ...]) -> dict[str, Callable[[int], float]]:
+    model = samples.model(variant)
+    ne = test_module("newton_euler")
+    found: dict[str, Callable[[int], float]] = {}
+    for motion in samples.MOTIONS:
+        for n in sizes:
+
+            def ours(motion: str = motion, n: int = n) -> Callable[[], object]:
+                a = samples.motion(motion, n)
+                return lambda: rpr3gen.evaluate(
+                    model, "inverse_dynamics", [a["q"], a["qd"], a["qdd"]]
+                )
+
+            def reference(motion: str = motion, n: int = n) -> Callable[[], object]:
+                a = samples.motion(motion, n)
+                params = dict(model.params)
+
+                def solve() -> None:
+                    for k in range(0, n, NE_CHUNK):
+                        s = slice(k, k + NE_CHUNK)
+                        ne.solve(params, variant, a["q"][s], a["qd"][s], a["qdd"][s])
+
+                return solve
+
+            found[f"numpy/{variant}/{motion}/{n}"] = timed(ours)
+            found[f"newton_euler/{variant}/{motion}/{n}"] = timed(reference)
+    return found
+
+
+def function_benchmarks(variant: str) -> dict[str, Callable[[int], float]]:
+    found_variant = manifest.load(variant)
+    model = samples.model(variant)
+    found: dict[str, Callable[[int], float]] = {}
+    for name, f in found_variant.functions.items():
+        if not samples.measurable(found_variant, f):
+            continue
+
+        def setup(f: Any = f) -> Callable[[], object]:
+            inputs = samples.inputs(variant, f, samples.motion("generic", 10**5))
+            return lambda: rpr3gen.evaluate(model, f.name, inputs, backend="numpy")
+
+        found[f"functions/{variant}/{name}"] = timed(setup)
+    return found
+
+
+def call_benchmarks(variant: str) -> dict[str, Callable[[int], float]]:
+    found_variant = manifest.load(variant)
+    model = samples.model(variant)
+    pose = samples.motion("generic", 3001)  # 1 ms apart, as a control loop's ticks
+    found: dict[str, Callable[[int], float]] = {}
+    for name, f in found_variant.functions.items():
+        if not all(a.name in samples.MOTION_INPUTS or a.name in ("qa", "q_near", "tau", "qa_dot")
+                   for a in f.inputs):  # fmt: skip
+            continue
+        for nan in (False, True):
+
+            def setup(name: str = name, f: Any = f, nan: bool = nan) -> Callable[[], object]:
+                ev = rpr3gen.SampleEvaluator(model, function=name)
+                for a in f.inputs:  # a valid sample: the motion's pose, or what it gives
+                    if a.name in samples.MOTION_INPUTS:
+                        ev.inputs[a.name][:] = pose[a.name][1500]
+                    elif a.name == "qa":
+                        ev.inputs[a.name][:] = rpr3gen.actuator_coordinates(
+                            model, pose["q"][1500:1501]
+                        )[0]
+                    elif a.name == "q_near":  # tracked: predicted from the last two poses
+                        ev.inputs[a.name][:] = 2.0 * pose["q"][1499] - pose["q"][1498]
+                    else:
+                        ev.inputs[a.name][:] = (1.0, -2.0, 0.5)
+                if nan:
+                    ev.inputs[f.inputs[0].name][0] = math.nan
+                assert (ev() != 0) == nan, f"{name}: unexpected return code"
+                return ev
+
+            found[f"calls/{variant}/{name}{'/nan' if nan else ''}"] = timed(setup)
+    return found
+
+
+def peer_benchmarks(variant: str) -> dict[str, Callable[[int], float]]:
+    try:
+        import mujoco
+    except ImportError:
+        return {}
+    peer = test_module("mujoco_peer")
+    model = samples.model(variant)
+
+    def setup() -> Callable[[], object]:
+        mj_model = mujoco.MjModel.from_xml_string(peer.build_mjcf(model.params, variant))
+        data = mujoco.MjData(mj_model)
+        peer.set_state(mj_model, data, (0.02, -0.03, 0.1), (0.05, 0.02, 0.1))
+        return lambda: mujoco.mj_forward(mj_model, data)
+
+    return {f"peers/{variant}/mj_forward": timed(setup)}
+
+
+def names(group: str) -> dict[str, Callable[[int], float]]:
+    """Every benchmark of ``group``, by name, over the variants found in ``generated/``."""
+    found: dict[str, Callable[[int], float]] = {}
+    for variant in samples.variants():
+        if group in SIZES:
+            found.update(numpy_benchmarks(variant, SIZES[group]))
+        else:
+            make = {"functions": function_benchmarks, "calls": call_benchmarks,
+                    "peers": peer_benchmarks}[group]  # fmt: skip
+            found.update(make(variant))
+    return found
+
+
+def add_group(cmd: list[str], args: Any) -> None:
+    """Forward the group to pyperf's worker processes."""
+    cmd.append(args.group)
+
+
+def main() -> None:
+    runner = pyperf.Runner(add_cmdline_args=add_group)
+    runner.argparser.add_argument("group", choices=GROUPS)
+    args = runner.parse_args()
+    if args.group == "regen":
+        runner.bench_command(
+            "regen/generate_check", [sys.executable, "-m", "rpr3gen.cli", "generate", "--check"]
+        )
+        return
+    for name, func in names(args.group).items():
+        runner.bench_time_func(name, func)
+    np.seterr(all="ignore")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,229 @@
+"""Tables from a benchmark run: ``python benchmarks/report.py results.json [--readme]``.
+
+Reads what ``run.py`` wrote and writes the Markdown beside it (``results.json`` ->
+``results.md``); with ``--readme`` also README.md's Performance block, between its
+``<!-- performance`` markers. Every figure comes from the one file; nothing is measured here.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import re
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+REPO = Path(__file__).resolve().parent.parent
+BEGIN = "<!-- performance: written by `python benchmarks/run.py --readme`; do not edit -->"
+END = "<!-- end of performance -->"
+#: The tick's generated calls in the Python example (control_loop.py's Controller).
+TICK_CALLS = ("forward_kinematics", "platform_velocity", "actuator_efforts")
+
+
+def table(head: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
+    lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    return "\n".join(lines + ["| " + " | ".join(row) + " |" for row in rows]) + "\n"
+
+
+def ns(value: float) -> str:
+    return f"{value:.0f} ns" if value >= 100 else f"{value:.1f} ns"
+
+
+def verdict(value: float, goal: float, below: bool) -> str:
+    ok = value <= goal if below else value >= goal
+    return "**pass**" if ok else "**miss**"
+
+
+def header(r: dict[str, Any]) -> str:
+    m = r["machine"]
+    load = (
+        " ".join(f"{x:.2f}" for x in r["load_start"]),
+        " ".join(f"{x:.2f}" for x in r["load_end"]),
+    )
+    kind = "quick" if r["quick"] else "full"
+    return (f"`python benchmarks/run.py`, {m['date']}, git {m['commit']} "
+            f"({kind}, {r['seconds']} s): "
+            f"{m['cpu']}, {m['cores']} logical cores ({m['usable_cores']} usable), {m['cc']}, "
+            f"Python {m['python']}, NumPy {m['numpy']}, pyperf {m['pyperf']}; load average "
+            f"{load[0]} at the start, {load[1]} at the end.\n")  # fmt: skip
+
+
+def c_figures(r: dict[str, Any], key: str) -> dict[str, dict[str, float]]:
+    """``{function: {"floor", "single", "batch": ns, "agree": 0|1}}``: the best of the repeats
+    (the least disturbed by other processes: the machine is shared)."""
+    found: dict[str, dict[str, float]] = {}
+    for name, value in r["c"][key]["results"].items():
+        function, what = name.split("/")
+        found.setdefault(function, {})[what] = value["agree"] if what == "agree" else value["min"]
+    return found
+
+
+def variants(r: dict[str, Any]) -> list[str]:
+    return sorted({key.split("/")[0] for key in r["c"]})
+
+
+def py(r: dict[str, Any], name: str) -> float | None:
+    found = r["python"].get(name)
+    return None if found is None else float(found["min"])
+
+
+def ne_ratios(r: dict[str, Any], variant: str) -> list[tuple[str, int, float, float]]:
+    """(motion, n, NumPy ns/sample, Newton-Euler ns/sample) of the variant."""
+    rows = []
+    for name in r["python"]:
+        parts = name.split("/")
+        if parts[0] == "numpy" and parts[1] == variant:
+            ours, ne = py(r, name), py(r, "newton_euler/" + "/".join(parts[1:]))
+            if ours and ne:
+                n = int(parts[3])
+                rows.append((parts[2], n, ours / n * 1e9, ne / n * 1e9))
+    return sorted(rows)
+
+
+def targets(r: dict[str, Any]) -> str:
+    rows = []
+    for v in variants(r):
+        c = c_figures(r, f"{v}/generic")
+        for f, goal in (("inverse_dynamics", 2.0), ("forward_dynamics", 2.0)):
+            x = c[f]["single"] / c[f]["floor"]
+            rows.append([f"C single / floor, `{f}` ({v})",
+                         f"{ns(c[f]['single'])} / {ns(c[f]['floor'])} = {x:.2f}x",
+                         f"≤ {goal}x", verdict(x, goal, True)])  # fmt: skip
+        x = c["inverse_dynamics"]["batch"] / c["inverse_dynamics"]["floor"]
+        rows.append([f"C batch / floor, `inverse_dynamics` ({v})", f"{x:.2f}x", "≤ 1.2x",
+                     verdict(x, 1.2, True)])  # fmt: skip
+        fd = c["forward_dynamics"]["single"]
+        rows.append([f"C forward dynamics, one call ({v})", ns(fd), "< 300 ns",
+                     verdict(fd, 300, True)])  # fmt: skip
+        for motion in ("generic", "rotation"):
+            ratios = [(ne / ours, n) for m, n, ours, ne in ne_ratios(r, v) if m == motion]
+            if ratios:
+                worst = min(ratios)[0]
+                text = ", ".join(f"{x:.1f}x at 10^{len(str(k)) - 1}" for x, k in ratios)
+                rows.append([f"NumPy vs Newton–Euler, {motion} motion ({v})", text, "≥ 20x",
+                             verdict(worst, 20, False)])  # fmt: skip
+        tick = [t["whole tick"]["p50"] for k, t in r["examples"]["c"].items() if k.startswith(v)]
+        if tick:
+            rows.append([f"C control tick p50, the example ({v})", ns(max(tick)), "< 500 ns",
+                         verdict(max(tick), 500, True)])  # fmt: skip
+        calls = [py(r, f"calls/{v}/{f}") for f in TICK_CALLS]
+        if all(calls):
+            total = sum(c for c in calls if c) * 1e6
+            rows.append([f"Python: a tick's generated calls, `SampleEvaluator` ({v})",
+                         f"{total:.2f} µs", "< 5 µs", verdict(total, 5, True)])  # fmt: skip
+        single = py(r, f"calls/{v}/inverse_dynamics")
+        if single:
+            rows.append([f"Python single call, `inverse_dynamics` ({v})", f"{single * 1e6:.3f} µs",
+                         "< 1 µs", verdict(single * 1e6, 1, True)])  # fmt: skip
+        big = py(r, f"numpy/{v}/generic/1000000")
+        if big:
+            rows.append([f"NumPy at 10^6, generic motion ({v})", f"{big * 1e3:.0f} ns/sample",
+                         "< 500 ns", verdict(big * 1e3, 500, True)])  # fmt: skip
+    regen = py(r, "regen/generate_check")
+    if regen:
+        rows.append(["full regeneration, `rpr3gen generate --check`", f"{regen:.2f} s", "< 5 s",
+                     verdict(regen, 5, True)])  # fmt: skip
+    return table(["target", "measured", "goal", "result"], rows)
+
+
+def functions(r: dict[str, Any], v: str) -> str:
+    rows = []
+    c = c_figures(r, f"{v}/generic")
+    for f, x in c.items():
+        numpy = py(r, f"functions/{v}/{f}")
+        cells = [f"`{f}`", ns(x["floor"])]
+        cells += [f"{ns(x[k])} = {x[k] / x['floor']:.2f}x" for k in ("single", "batch")]
+        cells.append(f"{ns(numpy * 1e4)} = {numpy * 1e4 / x['floor']:.2f}x" if numpy else "")
+        cells.append("yes" if x["agree"] == 1 else "**no**")
+        rows.append(cells)
+    rot = c_figures(r, f"{v}/rotation")["inverse_dynamics"]
+    rows.append(["`inverse_dynamics`, rotation motion", ns(rot["floor"]),
+                 *(f"{ns(rot[k])} = {rot[k] / rot['floor']:.2f}x" for k in ("single", "batch")),
+                 "", "yes" if rot["agree"] == 1 else "**no**"])  # fmt: skip
+    flags = r["c"][f"{v}/generic"]["flags"]
+    head = ["function", "floor", "C single", "C batch", "NumPy", "single = batch"]
+    return f"**{v}** (`cc {flags}`; ns per sample, best of the repeats):\n\n" + table(head, rows)
+
+
+def numpy_vs_ne(r: dict[str, Any]) -> str:
+    rows = [[v, m, f"10^{len(str(n)) - 1}", f"{ours:.0f} ns", f"{ne:.0f} ns", f"{ne / ours:.1f}x"]
+            for v in variants(r) for m, n, ours, ne in ne_ratios(r, v)]  # fmt: skip
+    return table(["variant", "motion", "samples", "NumPy", "Newton–Euler", "ratio"], rows)
+
+
+def control_loop(r: dict[str, Any]) -> str:
+    rows = []
+    for key in sorted(r["examples"]["c"]):
+        c, p = r["examples"]["c"][key], r["examples"]["python"].get(key, {})
+        cells = [*key.split("/")]
+        cells += [f"{c[k]['p50']:.0f}" for k in ("forward kinematics", "rest of the tick")]
+        cells.append(f"{c['whole tick']['p50']:.0f} / {c['whole tick']['p99']:.0f}")
+        if p:
+            cells.append(f"{p['whole tick']['p50'] / 1e3:.2f} / {p['whole tick']['p99'] / 1e3:.2f}")
+        rows.append(cells)
+    head = ["variant", "trajectory", "C: FK p50 (ns)", "C: rest p50", "C: tick p50 / p99",
+            "Python: tick p50 / p99 (µs)"]  # fmt: skip
+    return f"Build: `{r['examples']['build']}`\n\n" + table(head, rows)
+
+
+def calls(r: dict[str, Any]) -> str:
+    rows = []
+    for name in sorted(r["python"]):
+        parts = name.split("/")
+        if parts[0] == "calls" and len(parts) == 3:
+            call, nan = py(r, name), py(r, name + "/nan")
+            assert call is not None
+            floor = f"{nan * 1e6:.3f}" if nan else ""
+            rows.append([parts[1], f"`{parts[2]}`", f"{call * 1e6:.3f}", floor,
+                         f"{(call - (nan or 0)) * 1e6:.3f}"])  # fmt: skip
+    return table(["variant", "function", "call (µs)", "NaN input: the ctypes floor", "the C"], rows)
+
+
+def document(r: dict[str, Any]) -> str:
+    peers = [f"`mj_forward` ({name.split('/')[1]}) {py(r, name) * 1e6:.2f} µs"  # type: ignore[operator]
+             for name in sorted(r["python"]) if name.startswith("peers/")]  # fmt: skip
+    parts = [
+        "# Benchmark results\n", header(r), "\n## Targets\n", targets(r),
+        "\n## Every function against its floor (generic motion)\n",
+        "*Floor*: the libm calls the function's generated kernel makes (sin, cos, sqrt, atan2), "
+        "in a loop, nothing else. *C single*: the function once per sample, back to back; "
+        "*C batch*: over chunks of 1,000 samples, outputs in cache; *NumPy*: `evaluate` at "
+        "10^5 samples (allocation and checks included), ns per sample.\n",
+        *(functions(r, v) + "\n" for v in variants(r)),
+        "## NumPy against Newton–Euler\n",
+        "`evaluate(model, \"inverse_dynamics\", ...)` against `tests/newton_euler.py` on the same "
+        "samples (in chunks of 10^5), ns per sample, the best of pyperf's values.\n\n",
+        numpy_vs_ne(r),
+        "\n## The control-loop examples' latencies\n",
+        "Each program's own report, 3 s at 1 kHz (`examples/control_loop`).\n\n",
+        control_loop(r),
+        "\n## Python calls (`SampleEvaluator`, the C through ctypes)\n", calls(r),
+        "\n## Peers\n",
+        ", ".join(peers) + (" from Python.\n" if peers else "MuJoCo not installed.\n"),
+    ]  # fmt: skip
+    return "".join(parts)
+
+
+def readme_block(r: dict[str, Any]) -> str:
+    return "\n".join([BEGIN, header(r), targets(r), functions(r, "revolute"), control_loop(r), END])
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=(__doc__ or "").split("\n", 1)[0])
+    parser.add_argument("results", help="the JSON file run.py wrote")
+    parser.add_argument("--readme", action="store_true", help="also README.md's tables")
+    args = parser.parse_args(argv)
+    path = Path(args.results)
+    r = json.loads(path.read_text())
+    path.with_suffix(".md").write_text(document(r))
+    if args.readme:
+        readme = REPO / "README.md"
+        text = readme.read_text()
+        pattern = re.compile(re.escape(BEGIN) + ".*?" + re.escape(END), re.S)
+        readme.write_text(pattern.sub(lambda _: readme_block(r), text, count=1))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
