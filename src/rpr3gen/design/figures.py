@@ -87,12 +87,14 @@ def _pivots(ax: Axes, wmap: WorkspaceMap) -> list[Line2D]:
     """The base pivots A1, B1, C1 (inside the box or not; the axes keep the grid's limits); a
     general model's base joints at home, and the travel of a prismatic one (its rail)."""
     handles = []
+    slide = not wmap.model.structure.paper and wmap.model.structure.leg[0] == "P"
+    if slide:  # one legend entry for the three rails, in their legs' colours
+        handles.append(Line2D([], [], color="0.5", linewidth=3.0, alpha=0.6,
+                              label="rails (travel of A1, B1, C1)"))  # fmt: skip
     for leg, x, y in wmap.base_points():
-        slide = not wmap.model.structure.paper and wmap.model.structure.leg[0] == "P"
         if slide:
-            (h,) = ax.plot(*_rail(wmap, leg), color=LEG_COLORS[leg], linewidth=3.0, alpha=0.6,
-                           solid_capstyle="butt", label=f"rail {leg}1 (its travel)")  # fmt: skip
-            handles.append(h)
+            ax.plot(*_rail(wmap, leg), color=LEG_COLORS[leg], linewidth=3.0, alpha=0.6,
+                    solid_capstyle="butt")  # fmt: skip
         (h,) = ax.plot(
             x,
             y,
@@ -101,7 +103,7 @@ def _pivots(ax: Axes, wmap: WorkspaceMap) -> list[Line2D]:
             linestyle="none",
             color=LEG_COLORS[leg],
             markeredgecolor="k",
-            label=f"base slide {leg}1 at home" if slide else f"base pivot {leg}1",
+            label=f"slide {leg}1 at home" if slide else f"base pivot {leg}1",
         )
         handles.append(h)
     x0, x1, y0, y1 = _extent(wmap)
@@ -142,6 +144,7 @@ def conditioning_figure(wmap: WorkspaceMap) -> Figure:
         ax.contour(wmap.x, wmap.y, signed, levels=[0.0], colors="red", linewidths=2.0)
         handles.append(Line2D([], [], color="red", linewidth=2.0,
                               label="parallel singularity (conditioning 0)"))  # fmt: skip
+    drawn: set[str] = set()
     for k, (leg, family, lo, hi) in enumerate(wmap.limits):
         lam = np.ma.masked_invalid(wmap.coordinates[..., k])
         levels = [v for v in (lo, hi) if lam.count() and lam.min() < v < lam.max()]
@@ -151,9 +154,13 @@ def conditioning_figure(wmap: WorkspaceMap) -> Figure:
             )
             ax.contour(wmap.x, wmap.y, lam, levels=levels, colors=LEG_COLORS[leg],
                        linestyles=style, linewidths=1.5)  # fmt: skip
-            what = "stroke limit" if family == "lambda21" else f"limit of {family}"
-            handles.append(Line2D([], [], color=LEG_COLORS[leg], linestyle=style,
-                                  label=f"{what}, leg {leg}"))  # fmt: skip
+            if family == "lambda21":  # the paper's: one entry per leg
+                handles.append(Line2D([], [], color=LEG_COLORS[leg], linestyle=style,
+                                      label=f"stroke limit, leg {leg}"))  # fmt: skip
+            elif family not in drawn:  # one entry per coordinate, in the legs' colours
+                drawn.add(family)
+                handles.append(Line2D([], [], color="0.3", linestyle=style,
+                                      label=f"limit of {family}, each leg"))  # fmt: skip
     handles += _outline(ax, wmap, color="white")
     handles += _pivots(ax, wmap)
     _legend(fig, handles)

@@ -143,8 +143,8 @@ class WorkspaceMap:
 
     def limits_text(self, unicode: bool = True) -> str:
         """The limits in a line: ``strokes λ21 (m): [lo, hi], ...`` (the paper's format), or
-        ``q1 [-0.25, 0.25] m`` per coordinate, one bound for the legs that share it (``q2_A``
-        when they do not)."""
+        ``limits q1 [-0.25, 0.25] m`` per coordinate, once for the three legs when they show
+        the same bounds (else ``q1_A [...] m, q1_B ...``)."""
         if self.model.structure.paper:
             strokes = ", ".join(f"[{lo:.3g}, {hi:.3g}]" for _, _, lo, hi in self.limits)
             return f"strokes {'λ21' if unicode else 'lambda21'} (m): {strokes}"
@@ -156,10 +156,11 @@ class WorkspaceMap:
         parts = []
         for family, found in by_family.items():
             unit = "rad" if self.model.structure.leg[int(family[1]) - 1] == "R" else "m"
-            if len(found) == len(LEGS) and len({(lo, hi) for *_, lo, hi in found}) == 1:
-                parts.append(f"{family} [{found[0][2]:.3g}, {found[0][3]:.3g}] {unit}")
+            shown = {leg: f"[{lo:.3g}, {hi:.3g}] {unit}" for leg, _, lo, hi in found}
+            if len(shown) == len(LEGS) and len(set(shown.values())) == 1:
+                parts.append(f"{family} {shown[LEGS[0]]}")
             else:
-                parts += [f"{family}_{leg} [{lo:.3g}, {hi:.3g}] {unit}" for leg, _, lo, hi in found]
+                parts += [f"{family}_{leg} {text}" for leg, text in shown.items()]
         return "limits " + ", ".join(parts)
 
     def base_points(self) -> list[tuple[str, float, float]]:
