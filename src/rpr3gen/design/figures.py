@@ -25,6 +25,7 @@ from matplotlib.lines import Line2D
 
 from rpr3gen.atomic import atomic_write
 from rpr3gen.design.maps import WorkspaceMap
+from rpr3gen.model import LEGS
 from rpr3gen.plots import DPI
 
 __all__ = ["FIGSIZE", "FIGURES", "write_figures"]
@@ -85,15 +86,19 @@ def _outline(ax: Axes, wmap: WorkspaceMap, color: str = "k") -> list[Line2D]:
 
 def _pivots(ax: Axes, wmap: WorkspaceMap) -> list[Line2D]:
     """The base pivots A1, B1, C1 (inside the box or not; the axes keep the grid's limits); a
-    general model's base joints at home, and the travel of a prismatic one (its rail)."""
+    general model's base joints at home and the rails of prismatic ones, in the legend when
+    they are in the map."""
+    x0, x1, y0, y1 = _extent(wmap)
+    general = not wmap.model.structure.paper
+    slide = general and wmap.model.structure.leg[0] == "P"
+    rails = [_rail(wmap, leg) for leg in LEGS] if slide else []
     handles = []
-    slide = not wmap.model.structure.paper and wmap.model.structure.leg[0] == "P"
-    if slide:  # one legend entry for the three rails, in their legs' colours
+    if any(_inside((x0, x1, y0, y1), *rail) for rail in rails):  # one entry, legs' colours
         handles.append(Line2D([], [], color="0.5", linewidth=3.0, alpha=0.6,
                               label="rails (travel of A1, B1, C1)"))  # fmt: skip
-    for leg, x, y in wmap.base_points():
+    for k, (leg, x, y) in enumerate(wmap.base_points()):
         if slide:
-            ax.plot(*_rail(wmap, leg), color=LEG_COLORS[leg], linewidth=3.0, alpha=0.6,
+            ax.plot(*rails[k], color=LEG_COLORS[leg], linewidth=3.0, alpha=0.6,
                     solid_capstyle="butt")  # fmt: skip
         (h,) = ax.plot(
             x,
@@ -105,11 +110,20 @@ def _pivots(ax: Axes, wmap: WorkspaceMap) -> list[Line2D]:
             markeredgecolor="k",
             label=f"slide {leg}1 at home" if slide else f"base pivot {leg}1",
         )
-        handles.append(h)
-    x0, x1, y0, y1 = _extent(wmap)
+        if not general or _inside((x0, x1, y0, y1), [x], [y]):
+            handles.append(h)
     ax.set_xlim(x0, x1)
     ax.set_ylim(y0, y1)
     return handles
+
+
+def _inside(box: tuple[float, float, float, float], xs: list[float], ys: list[float]) -> bool:
+    """Some point of the polyline ``xs, ys`` (sampled) is inside ``box``."""
+    t = np.linspace(0.0, 1.0, 65)[:, np.newaxis]
+    points = np.column_stack([xs, ys])
+    path = points[:-1] + t[..., np.newaxis] * np.diff(points, axis=0) if len(xs) > 1 else points
+    px, py = np.reshape(path, (-1, 2)).T
+    return bool(np.any((px >= box[0]) & (px <= box[1]) & (py >= box[2]) & (py <= box[3])))
 
 
 def _rail(wmap: WorkspaceMap, leg: str) -> tuple[list[float], list[float]]:
