@@ -213,7 +213,7 @@ def _parser() -> argparse.ArgumentParser:
     ws = sub.add_parser(
         "workspace",
         help="workspace and singularity maps of a design at a fixed platform angle",
-        description="Map the positions of G reachable at the platform angle PHI (strokes, "
+        description="Map the positions of G reachable at the platform angle PHI (joint limits, "
         "conditioning), the conditioning with the singularity curves, the static actuator "
         "efforts holding the robot at rest and the reachable orientation range; write "
         "DIR/workspace.parquet and four PNG figures.",
