@@ -245,8 +245,9 @@ def coordinates(
     """(n, k): the bounded joint coordinates (``limits``' order) at the poses ``q`` (n, 3).
 
     The paper's format: ``lambda21`` from the geometry (eq. 5). The general format: the joint
-    coordinates of the generated inverse dynamics at rest (``found``, when it already holds
-    them); only at ``rows`` when given (NaN elsewhere).
+    coordinates of the generated code (``found``, when it already holds them: the inverse
+    dynamics at rest; else the actuator coordinates when only the motors' joints are bounded,
+    or the inverse dynamics at rest); only at ``rows`` when given (NaN elsewhere).
 
     Args:
         model: picks the generated variant.
@@ -269,11 +270,22 @@ def coordinates(
         if not at.size:
             return out
         p = params[:, at] if params.ndim == 2 else params
-        zero = np.zeros((at.size, 3))
-        found = evaluate_stacked(model, "inverse_dynamics", p, [q[at], zero, zero])
+        found = _evaluate_coordinates(model, limits, p, q[at])
         out[at] = np.stack([found[name] for name in names], axis=1)
         return out
     return np.stack([found[name] for name in names], axis=1)
+
+
+def _evaluate_coordinates(
+    model: Model, limits: Sequence[Limit], params: np.ndarray, q: np.ndarray
+) -> Evaluated:
+    """A general model's generated function that gives the bounded coordinates at ``q``, with
+    ``conditioning`` and the return codes: ``actuator_coordinates`` when only the motors'
+    joints are bounded (or none), else the inverse dynamics at rest (every joint's)."""
+    if all(family == model.structure.actuator for _, family, _, _ in limits):
+        return evaluate_stacked(model, "actuator_coordinates", params, [q])
+    zero = np.zeros_like(q)
+    return evaluate_stacked(model, "inverse_dynamics", params, [q, zero, zero])
 
 
 def reachable(
@@ -298,9 +310,9 @@ def reachable(
         found = evaluate_stacked(model, "actuator_coordinates", params, [q])
         lambda21 = piston_displacements(params, q)
         return within(found.ok(), found["conditioning"], lambda21, limits, min_conditioning)
-    zero = np.zeros_like(q)
-    found = evaluate_stacked(model, "inverse_dynamics", params, [q, zero, zero])
-    coords = coordinates(model, params, q, design_limits(model), found)
+    bounded = design_limits(model)
+    found = _evaluate_coordinates(model, bounded, params, q)
+    coords = coordinates(model, params, q, bounded, found)
     return within(found.ok(), found["conditioning"], coords, limits, min_conditioning)
 
 
