@@ -444,3 +444,22 @@ def test_sweep_command_with_a_general_model(
     table = pq.read_table(out)
     assert table.column_names == ["legs.A.inertia[0]", *GENERAL_RESULT_COLUMNS]
     assert np.isnan(table.column("workspace_area").to_numpy()).all()
+
+
+def test_a_default_travel_is_named_as_such_in_the_reason() -> None:
+    """Leg C's rail would pass its default travel (the 3-PRR has no [limits])."""
+    t = np.linspace(0.0, 1.0, 21)
+    s = 3 * t**2 - 2 * t**3  # rest to rest
+    q = np.column_stack([0.2 * s, np.full_like(t, 0.1), np.zeros_like(t)])
+    qd = np.column_stack([0.2 * (6 * t - 6 * t**2), np.zeros_like(t), np.zeros_like(t)])
+    qdd = np.column_stack([0.2 * (6 - 12 * t), np.zeros_like(t), np.zeros_like(t)])
+    line = rpr3gen.Trajectory(t=t, q=q, qd=qd, qdd=qdd)
+    table = rpr3gen.sweep(_prr(), {"platform.mass": [2.0]}, [line], workers=0, area_resolution=0)
+    (row,) = table.to_pylist()
+    assert not row["feasible"]
+    assert re.fullmatch(
+        r"trajectory 1: t = \S+ s: joint coordinate q1_C = -0\.4\d+ m outside its limits "
+        r"\[-0\.424264, 0\.424264\] \(the design studies' default travel; set \[limits\] in the "
+        r"model file\)",
+        row["reason"],
+    ), row["reason"]

@@ -85,6 +85,9 @@ revolute joint's moment)."""
 GENERAL_RESULT_COLUMNS: tuple[str, ...] = (*_INTERFACE_COLUMNS, *GENERAL_JOINT_COLUMNS)
 """The columns after the grid's keys, in order, for a base model of the general format."""
 
+#: How a reason names a limit that is the design studies' default (not the model's).
+_DEFAULT_LIMIT = "(the design studies' default travel; set [limits] in the model file)"
+
 #: Samples per generated call when computing areas (designs x grid points).
 _AREA_BLOCK = 4 * BLOCK
 
@@ -251,7 +254,7 @@ def _trajectory_metrics(
                 moments = np.concatenate([get(f"m{j}_{leg}") for leg in LEGS], axis=1)
                 results[f"peak_m{j}"][at] = _peak(moments)
         for j in map(int, np.flatnonzero(~valid.all(axis=1))):
-            model = design_model(models[lo + j])
+            model = models[lo + j]
             bounded = {f"{f}_{leg}": values[j][:, i] for i, (leg, f, _, _) in enumerate(limits)}
             results["reason"][at[j]] = _reason(plan, model, which, t, q, conditioning[j], bounded)
 
@@ -287,18 +290,23 @@ def _reason(
 ) -> str:
     """``"<trajectory>: t = <time> s: <why>"`` for the first pose at fault of one design.
 
-    ``model`` holds the design's limits (:func:`rpr3gen.design.reach.design_model`); ``values``
-    the bounded joint coordinates by output name, (S,) each.
+    ``values``: the bounded joint coordinates by output name, (S,) each. A limit that is the
+    design studies' default, not the model's, is named so.
     """
     thresholds = variants.load(model.structure, model.generated).thresholds
+    limited = design_model(model)
     for i, name in enumerate(plan.names):
         at = which == i
         out = {"conditioning": conditioning[at]}
         for key, column in values.items():
             out[key] = column[at]
-        invalid = invalid_samples(model, q[at], out, plan.min_conditioning, thresholds)
+        invalid = invalid_samples(limited, q[at], out, plan.min_conditioning, thresholds)
         if invalid is not None:
-            return f"{name}: t = {t[at][invalid.first]:.6g} s: {invalid.reason}"
+            reason = invalid.reason
+            for key in limited.limits or {}:
+                if key not in (model.limits or {}):
+                    reason = reason.replace(f"(limits.{key})", _DEFAULT_LIMIT)
+            return f"{name}: t = {t[at][invalid.first]:.6g} s: {reason}"
     return ""
 
 
