@@ -251,7 +251,7 @@ def test_output_paths_in_the_way_are_refused_before_any_work(tmp_path: Path) -> 
 def test_an_unwritable_out_names_the_users_file(tmp_path: Path) -> None:
     result = _cli("simulate", "--out", "/proc/x.csv", cwd=tmp_path)
     assert result.returncode == 2
-    assert result.stderr.startswith("rpr3gen: error: /proc/x.csv: cannot write: ")
+    assert result.stderr.startswith("rpr3gen: error: /proc/x.csv: cannot write the CSV: ")
     assert ".tmp" not in result.stderr
 
 

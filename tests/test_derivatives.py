@@ -168,7 +168,7 @@ def test_bad_positions_only_input(tmp_path: Path) -> None:
         (["--smoothing", "1e-3"], "--smoothing: only for a trajectory CSV file"),
         (["--trajectory", "FULL", "--smoothing", "1e-3"], "smoothing is for a file of positions"),
         (["--trajectory", "SHORT"], "at least 6"),
-        (["--trajectory", "FULL", "--smoothing", "-1"], "smoothing: must be a finite number"),
+        (["--trajectory", "FULL", "--smoothing", "-1"], "--smoothing: must be a number in [0"),
     ],
 )
 def test_cli_smoothing_errors(args: list[str], needle: str, tmp_path: Path) -> None:

@@ -183,8 +183,8 @@ def test_default_stroke_without_limits_and_the_models_with() -> None:
     [
         ({"resolution": 1}, "resolution: must be an integer >= 2"),
         ({"resolution": 10.0}, "resolution: must be an integer >= 2"),
-        ({"phi": math.nan}, "phi: must be a finite angle"),
-        ({"min_conditioning": 1.0}, "min_conditioning: must be in [0, 1)"),
+        ({"phi": math.nan}, "phi: must be a finite number (rad)"),
+        ({"min_conditioning": 1.0}, "min_conditioning: must be a number in [0, 1)"),
     ],
 )
 def test_bad_arguments(kwargs: dict[str, Any], message: str) -> None:

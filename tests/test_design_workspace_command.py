@@ -44,7 +44,7 @@ def test_writes_the_grid_and_four_figures(
     ("args", "message"),
     [
         (["--resolution", "1"], "--resolution: must be an integer >= 2, got 1"),
-        (["--phi", "nan"], "--phi: must be a finite angle in degrees"),
+        (["--phi", "nan"], "--phi: must be a finite number (deg)"),
         (["--model", "nope.toml"], "nope.toml: model file not found"),
     ],
 )

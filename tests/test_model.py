@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 import rpr3gen.model
-from rpr3gen.errors import ModelError, Rpr3genError
+from rpr3gen.errors import InputTypeError, ModelError, Rpr3genError
 from rpr3gen.model import ACTUATIONS, PARAM_NAMES, Model, load_model, model_from_dict
 
 REPO = Path(__file__).resolve().parents[1]
@@ -219,7 +219,7 @@ def test_model_from_dict_accepts_tuples_and_arrays() -> None:
     assert model.vector() == pytest.approx(load_model().vector(), rel=1e-15, abs=1e-15)
     with pytest.raises(ModelError, match=r"^nb: geometry\.l0: must be a positive number"):
         model_from_dict({**data, "geometry": {**data["geometry"], "l0": 0}}, source="nb")
-    with pytest.raises(ModelError, match="must be a table"):
+    with pytest.raises(InputTypeError, match="data: must be a mapping"):
         model_from_dict([1, 2])  # type: ignore[arg-type]
 
 

@@ -116,9 +116,11 @@ class _Leg:
 
     def angle(self, reference: Reference, current: Vec) -> sp.Expr:
         """The rotation from ``reference.home`` to ``current`` (any positive multiple of the
-        reference's current value), in ``(-pi, pi]`` (``[-pi, pi]`` from a given angle)."""
+        reference's current value), in ``(-pi, pi]`` (``[-pi, pi]`` from a given angle, the
+        difference named before it is wrapped, so that it is computed once)."""
         if reference.angle is not None:
-            return wrap_angle(sp.atan2(current[1], current[0]) - reference.angle)
+            turn = self.define("turn", sp.atan2(current[1], current[0]) - reference.angle)
+            return wrap_angle(turn)
         h = reference.home
         return sp.atan2(cross(h, current), dot(h, current))
 

@@ -450,6 +450,41 @@ def pose_diagnostics(structure: Structure) -> FunctionSpec:
     )
 
 
+def joint_points(structure: Structure) -> FunctionSpec:
+    """``rpr3_joint_points``: where every joint of every leg is, for drawing the robot."""
+    prog = Program()
+    derivation = control.include_inverse_dynamics(prog, structure)
+    values, components = [], []
+    for leg in LEGS:
+        kin = derivation.kinematics[leg]
+        x3 = (syms.x + kin.s[0], syms.y + kin.s[1])
+        arms = [kin.pose.world(arm) for arm in kin.pose.arms]
+        points = (
+            (x3[0] - arms[0][0], x3[1] - arms[0][1]),
+            (x3[0] - arms[1][0], x3[1] - arms[1][1]),
+            x3,
+        )
+        for j, point in enumerate(points, start=1):
+            for axis, value in zip("xy", point, strict=True):
+                values.append(value)
+                components.append(
+                    Component(
+                        f"{axis}{j}_{leg}", "m", f"leg {leg}: joint {j}'s point, world {axis}0"
+                    )
+                )
+    return FunctionSpec(
+        name="joint_points",
+        doc="The current points of joints 1, 2, 3 of legs A, B, C (world frame) at the platform "
+        "pose q, each leg in its working mode (eq. 5): what a drawing of the robot needs.",
+        inputs=(POSE,),
+        outputs=(
+            Output("points", tuple(values), tuple(components), "x1_A, y1_A, ..., x3_C, y3_C"),
+        ),
+        program=prog,
+        checks=_pose_checks(prog, structure),
+    )
+
+
 def fk_kind(structure: Structure) -> str:
     """How a locked leg holds the platform: ``circle``, ``line`` or ``platform_line``."""
     return direct_kinematics.locked_kind(structure.kinds, structure.actuated)
@@ -790,6 +825,7 @@ FUNCTIONS: Mapping[str, FunctionBuilder] = {
     "inverse_dynamics": inverse_dynamics,
     "actuator_coordinates": actuator_coordinates,
     "pose_diagnostics": pose_diagnostics,
+    "joint_points": joint_points,
     "actuator_jacobian": actuator_jacobian,
     "jacobian_rate": jacobian_rate,
     "platform_velocity": platform_velocity,

@@ -1,4 +1,5 @@
-"""rpr3gen: inverse dynamics of the 3-RPR planar parallel robot (S. Staicu), from generated code.
+"""rpr3gen: dynamics of planar parallel robots (the 3-RPR of S. Staicu, and any planar 3-leg
+robot), from generated code.
 
 >>> import rpr3gen
 >>> model = rpr3gen.load_model()                   # the paper's robot
@@ -50,7 +51,7 @@ from rpr3gen.identification import (
     payload_efforts,
     regressor,
 )
-from rpr3gen.model import PARAM_NAMES, Model, load_model
+from rpr3gen.model import PARAM_NAMES, Model, load_model, model_from_dict
 from rpr3gen.sample import SampleEvaluator
 from rpr3gen.trajectory import Trajectory, paper_trajectory, read_trajectory_csv
 
@@ -93,6 +94,7 @@ __all__ = [
     "inverse_dynamics",
     "jacobian_rate",
     "load_model",
+    "model_from_dict",
     "paper_trajectory",
     "payload_efforts",
     "platform_radius",

@@ -16,10 +16,11 @@ from collections.abc import Iterator, Sequence
 import numpy as np
 from numpy.typing import ArrayLike
 
-from rpr3gen import manifest, policy, variants
-from rpr3gen.errors import InputError
+from rpr3gen import manifest, policy, sizes, variants
+from rpr3gen.errors import InputError, InputTypeError
 from rpr3gen.evaluators import BACKENDS, NumpyEvaluator, evaluator, thread_count
 from rpr3gen.model import Model
+from rpr3gen.validation import Check, Instance, Rows, check_same_length, checked, describe
 
 __all__ = ["BACKENDS", "OUTPUT_NAMES", "evaluate", "inverse_dynamics", "output_names"]
 
@@ -38,16 +39,28 @@ PROGRESS_DELAY = 0.5
 
 
 def samples(name: str, value: ArrayLike, size: int) -> np.ndarray:
-    """``value`` as a C-contiguous float64 (n, size) array; one sample may be given as (size,)."""
-    try:
-        array = np.asarray(value, dtype=np.float64)
-    except (TypeError, ValueError) as exc:
-        raise InputError(f"{name} must be an array of numbers: {exc}") from None
-    if array.ndim == 1 and array.shape == (size,):
-        array = array[np.newaxis, :]
-    if array.ndim != 2 or array.shape[1] != size:
-        raise InputError(f"{name} must have shape (n, {size}), got {np.shape(value)}")
-    return np.ascontiguousarray(array)
+    """``value`` as a C-contiguous float64 (n, size) array; one sample may be given as (size,)
+    (:class:`rpr3gen.validation.Rows`)."""
+    return Rows(size)(name, value)
+
+
+class _Inputs(Check):
+    """``evaluate``'s ``inputs``: a list or tuple, one array per input of the function."""
+
+    def __call__(self, name: str, value: object) -> Sequence[ArrayLike]:
+        if not isinstance(value, list | tuple):
+            raise InputTypeError(
+                f"{name}: must be a list or tuple of arrays, one per input of the function, "
+                f"got {describe(value)}",
+                argument=name,
+            )
+        return value
+
+
+def _evaluation_bytes(n: int, info: manifest.FunctionInfo) -> int:
+    """Bytes of n samples of ``info``'s inputs and outputs."""
+    values = sum(a.size for a in info.inputs) + sum(o.size for o in info.outputs)
+    return n * values * sizes.EVALUATED_VALUE
 
 
 def _blocks(n: int, progress: bool, block: int = BLOCK) -> Iterator[slice]:
@@ -85,6 +98,7 @@ def _blocks(n: int, progress: bool, block: int = BLOCK) -> Iterator[slice]:
         yield from blocks
 
 
+@checked(function=Instance(str, "the name of a generated function"), inputs=_Inputs())
 def evaluate(
     model: Model,
     function: str,
@@ -109,14 +123,25 @@ def evaluate(
         codes (0: ok). The outputs of a failed sample are NaN, whatever the backend.
     """
     variant = variants.load(model.structure, model.generated)
+    if function not in variant.functions:
+        known = ", ".join(variant.functions)
+        raise InputError(
+            f"function: no generated function {function!r} (there are: {known})",
+            argument="function",
+        )
     info = variant.function(function)
     if len(inputs) != len(info.inputs):
-        raise InputError(f"{function} takes {len(info.inputs)} inputs, got {len(inputs)}")
-    arrays = [samples(arg.name, a, arg.size) for arg, a in zip(info.inputs, inputs, strict=True)]
-    if len({a.shape[0] for a in arrays}) != 1:
-        shapes = ", ".join(str(a.shape) for a in arrays)
         names = ", ".join(arg.name for arg in info.inputs)
-        raise InputError(f"{names} differ in shape: {shapes}")
+        raise InputError(
+            f"inputs: {function} takes {len(info.inputs)} ({names}), got {len(inputs)}",
+            argument="inputs",
+        )
+    arrays = [samples(f"inputs: {arg.name}", a, arg.size)
+              for arg, a in zip(info.inputs, inputs, strict=True)]  # fmt: skip
+    check_same_length({arg.name: a for arg, a in zip(info.inputs, arrays, strict=True)}, "inputs")
+    first = info.inputs[0].name
+    sizes.check(first, len(arrays[0]), lambda n: _evaluation_bytes(n, info),
+                f"the inputs and outputs of {function}", unit="samples")  # fmt: skip
     count = thread_count(threads)
     ev = evaluator(variant, backend)
     params = model.vector(variant.param_names)
@@ -139,6 +164,7 @@ def output_names(model: Model) -> tuple[str, ...]:
     return info.outputs[0].names
 
 
+@checked(q=Rows(3), qd=Rows(3), qdd=Rows(3), same_length=[("q", "qd", "qdd")])
 def inverse_dynamics(
     model: Model,
     q: ArrayLike,

@@ -27,6 +27,7 @@ from pathlib import Path
 from typing import Any
 
 from rpr3gen.errors import Rpr3genError
+from rpr3gen.loader import check_files
 from rpr3gen.manifest import Variant
 
 #: ISO C99 (no FMA contraction), -O3; no errno from sqrt and no floating-point traps, so that
@@ -73,7 +74,8 @@ def _compiler() -> list[str]:
 
 
 def sources(variant: Variant) -> tuple[bytes, bytes]:
-    """The generated C source and header of a variant."""
+    """The generated C source and header of a variant, checked (:mod:`rpr3gen.loader`)."""
+    check_files(variant)
     return variant.path("c_source").read_bytes(), variant.path("c_header").read_bytes()
 
 

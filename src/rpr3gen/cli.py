@@ -18,12 +18,14 @@ import sys
 import warnings
 from collections.abc import Iterator, Sequence
 from pathlib import Path
-from typing import NoReturn, TextIO
+from typing import TextIO
 
 import numpy as np
 
-from rpr3gen import __version__, cli_identification, variants
+from rpr3gen import __version__, cli_identification, sizes, variants
 from rpr3gen.backends import BACKENDS, inverse_dynamics, output_names
+from rpr3gen.cli_args import EXIT_ERROR, Parser, as_option, integer, number, subparser
+from rpr3gen.derivatives import MAX_SMOOTHING
 from rpr3gen.design.maps import DEFAULT_RESOLUTION, WorkspaceMap
 from rpr3gen.design.sweeps import (
     DEFAULT_AREA_RESOLUTION,
@@ -38,56 +40,27 @@ from rpr3gen.errors import (
     did_you_mean,
 )
 from rpr3gen.model import Model, load_model
+from rpr3gen.paths import check_output
 from rpr3gen.policy import DEFAULT_MIN_CONDITIONING, Invalid, invalid_samples
 from rpr3gen.structure import LEG_TYPES, Structure
 from rpr3gen.trajectory import (
     DEFAULT_DURATION,
     DEFAULT_SAMPLES,
+    DURATIONS,
     PAPER_TRAJECTORIES,
     Trajectory,
     paper_trajectory,
     read_trajectory_csv,
 )
 
-EXIT_ERROR = 2
-
-
-class _Parser(argparse.ArgumentParser):
-    """Usage errors as one line, like every other error of the command."""
-
-    def error(self, message: str) -> NoReturn:
-        self.exit(EXIT_ERROR, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
-
-
-def _conditioning_threshold(text: str) -> float:
-    """Type of ``--min-conditioning``: a number in [0, 1) (conditioning is 1 at best)."""
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
-    if not 0.0 <= value < 1.0:
-        raise argparse.ArgumentTypeError(
-            f"must be in [0, 1), got {text}: conditioning is at most 1, so a threshold of 1 "
-            "or more refuses every pose"
-        )
-    return value
-
-
-def _threads(text: str) -> int:
-    """Type of ``--threads``: a positive integer."""
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not an integer: {text!r}") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"must be at least 1, got {text}")
-    return value
+#: ``type=`` of every ``--min-conditioning``: conditioning is 1 at best, so 1 would refuse all.
+_CONDITIONING = number(least=0.0, below=1.0)
 
 
 def _add_threads(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--threads",
-        type=_threads,
+        type=integer(1),
         metavar="N",
         help="threads of the c backend (default: every core this process may use); the "
         "results do not depend on it",
@@ -95,7 +68,7 @@ def _add_threads(parser: argparse.ArgumentParser) -> None:
 
 
 def _parser() -> argparse.ArgumentParser:
-    parser = _Parser(
+    parser = Parser(
         prog="rpr3gen",
         description="Inverse dynamics of the 3-RPR planar parallel robot (Staicu), "
         "from generated code. SI units throughout (m, rad, s, N, N·m).",
@@ -103,7 +76,7 @@ def _parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--version", action="version", version=f"rpr3gen {__version__}")
     parser.add_argument("--debug", action="store_true", help="show tracebacks on errors")
-    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=Parser)
     paper_model = "default: the paper's robot, models/paper.toml"
 
     sim = sub.add_parser("simulate", help="evaluate the inverse dynamics over a trajectory")
@@ -117,20 +90,20 @@ def _parser() -> argparse.ArgumentParser:
     )
     sim.add_argument(
         "--samples",
-        type=int,
+        type=integer(2),
         metavar="N",
         help="number of samples of a paper trajectory, both ends included "
         f"(default: {DEFAULT_SAMPLES})",
     )
     sim.add_argument(
         "--duration",
-        type=float,
+        type=number(least=DURATIONS[0], most=DURATIONS[1], unit="s"),
         metavar="T",
         help=f"duration of a paper trajectory, s (default: {DEFAULT_DURATION:g})",
     )
     sim.add_argument(
         "--smoothing",
-        type=float,
+        type=number(least=0.0, most=MAX_SMOOTHING),
         metavar="S",
         help="for a CSV file of positions only (t,x,y,phi): RMS deviation allowed between the "
         "quintic spline whose derivatives give the velocities and accelerations and the "
@@ -156,7 +129,7 @@ def _parser() -> argparse.ArgumentParser:
     )
     sim.add_argument(
         "--min-conditioning",
-        type=_conditioning_threshold,
+        type=_CONDITIONING,
         default=DEFAULT_MIN_CONDITIONING,
         metavar="C",
         help="refuse poses whose output 'conditioning' (dimensionless, 0 = singular, 1 = best) "
@@ -207,7 +180,7 @@ def _parser() -> argparse.ArgumentParser:
         help="use the generated code that `rpr3gen generate` wrote into DIR "
         "(default: the installed generated package)",
     )
-    fk.add_argument("qa", nargs=3, type=float, metavar="QA", help="actuator coordinate")
+    fk.add_argument("qa", nargs=3, type=number(), metavar="QA", help="actuator coordinate")
 
     cli_identification.add_parsers(sub, paper_model)
     ws = sub.add_parser(
@@ -220,11 +193,15 @@ def _parser() -> argparse.ArgumentParser:
     )
     ws.add_argument("--model", metavar="FILE", help=f"model TOML file ({paper_model})")
     ws.add_argument(
-        "--phi", type=float, default=0.0, metavar="DEG", help="platform angle, degrees (default: 0)"
+        "--phi",
+        type=number(unit="deg"),
+        default=0.0,
+        metavar="DEG",
+        help="platform angle, degrees (default: 0)",
     )
     ws.add_argument(
         "--resolution",
-        type=int,
+        type=integer(2),
         default=DEFAULT_RESOLUTION,
         metavar="N",
         help=f"grid points along x and along y (default: {DEFAULT_RESOLUTION})",
@@ -234,7 +211,7 @@ def _parser() -> argparse.ArgumentParser:
     )
     ws.add_argument(
         "--min-conditioning",
-        type=_conditioning_threshold,
+        type=_CONDITIONING,
         default=DEFAULT_MIN_CONDITIONING,
         metavar="C",
         help=f"poses below this conditioning are not reachable (default: "
@@ -254,20 +231,21 @@ def _parser() -> argparse.ArgumentParser:
     sw.add_argument(
         "--trajectory",
         action="append",
+        dest="trajectories",
         metavar="NAME|FILE.csv",
         help="'rotation', 'rectilinear' or a trajectory CSV file; repeat for several "
         "(default: rotation and rectilinear)",
     )
     sw.add_argument(
         "--samples",
-        type=int,
+        type=integer(2),
         default=DEFAULT_SAMPLES,
         metavar="N",
         help=f"samples of each paper trajectory (default: {DEFAULT_SAMPLES})",
     )
     sw.add_argument(
         "--duration",
-        type=float,
+        type=number(least=DURATIONS[0], most=DURATIONS[1], unit="s"),
         default=DEFAULT_DURATION,
         metavar="T",
         help=f"duration of each paper trajectory, s (default: {DEFAULT_DURATION:g})",
@@ -280,7 +258,7 @@ def _parser() -> argparse.ArgumentParser:
     )
     sw.add_argument(
         "--workers",
-        type=int,
+        type=integer(0),
         metavar="N",
         help="processes of the local cluster (default: one per core); 0 runs in this process "
         "without Dask",
@@ -298,14 +276,14 @@ def _parser() -> argparse.ArgumentParser:
     )
     sw.add_argument(
         "--chunk-size",
-        type=int,
+        type=integer(1),
         default=DEFAULT_CHUNK_SIZE,
         metavar="N",
         help=f"designs per task and per part file (default: {DEFAULT_CHUNK_SIZE})",
     )
     sw.add_argument(
         "--area-resolution",
-        type=int,
+        type=integer(0),
         default=DEFAULT_AREA_RESOLUTION,
         metavar="N",
         help="grid points per axis of each design's workspace area; 0: no area "
@@ -313,7 +291,7 @@ def _parser() -> argparse.ArgumentParser:
     )
     sw.add_argument(
         "--min-conditioning",
-        type=_conditioning_threshold,
+        type=_CONDITIONING,
         default=DEFAULT_MIN_CONDITIONING,
         metavar="C",
         help=f"a pose below this conditioning makes a design infeasible (default: "
@@ -370,6 +348,9 @@ def _trajectory(args: argparse.Namespace) -> tuple[str, Trajectory]:
                 "--smoothing: only for a trajectory CSV file of positions; "
                 f"{args.trajectory!r} has analytic derivatives"
             )
+        sizes.check("samples", timing.get("samples", DEFAULT_SAMPLES),
+                    lambda n: n * sizes.SIMULATED_SAMPLE, "the simulation, its CSV and figures",
+                    least=2, argument="samples")  # fmt: skip
         return args.trajectory, paper_trajectory(args.trajectory, **timing)
     path = Path(args.trajectory)
     if path.suffix.lower() != ".csv" and not path.exists():
@@ -458,22 +439,6 @@ def _warnings_as_lines() -> Iterator[None]:
         yield
 
 
-def _check_destination(path: Path, what: str, *, folder: bool) -> None:
-    """Refuse, before any work, an output path that an existing file or folder stands in the way of.
-
-    ``path`` is the file (``folder=False``) or the folder to be written; folders missing on the
-    way are created later.
-    """
-    if not folder and path.is_dir():
-        raise Rpr3genError(f"{path}: cannot write {what}: it is a folder")
-    for part in (path, *path.parents) if folder else path.parents:
-        if part.exists():
-            if not part.is_dir():
-                it = "it" if part == path else str(part)
-                raise Rpr3genError(f"{path}: cannot write {what}: {it} is a file, not a folder")
-            return
-
-
 def simulate(
     model: Model,
     name: str,
@@ -498,9 +463,9 @@ def simulate(
     if not 0.0 <= min_conditioning < 1.0:
         raise InputError(f"min_conditioning: must be in [0, 1), got {min_conditioning!r}")
     if out_csv:
-        _check_destination(Path(out_csv), "the CSV", folder=False)
+        check_output(out_csv, "the CSV", argument="out")
     if plots_dir:
-        _check_destination(Path(plots_dir), "the figures", folder=True)
+        check_output(plots_dir, "the figures", folder=True, argument="plots")
     out = inverse_dynamics(
         model, traj.q, traj.qd, traj.qdd, backend=backend, progress=True, threads=threads
     )
@@ -598,9 +563,7 @@ def _cmd_fk(args: argparse.Namespace) -> int:
     from rpr3gen.control import assembly_modes
 
     model = load_model(args.model, generated=args.generated)
-    qa = np.array(args.qa)
-    if not np.isfinite(qa).all():
-        raise InputError(f"QA: actuator coordinates must be finite, got {args.qa}")
+    qa = np.array(args.qa)  # three finite numbers (cli_args.number)
     modes = assembly_modes(model, qa)
     zero = np.zeros_like(modes)
     conditioning = (
@@ -621,12 +584,7 @@ def _cmd_workspace(args: argparse.Namespace) -> int:
     from rpr3gen.design import workspace, write_workspace
 
     model = load_model(args.model)
-    if not np.isfinite(args.phi):
-        raise InputError(f"--phi: must be a finite angle in degrees, got {args.phi}")
-    if args.resolution < 2:
-        raise InputError(f"--resolution: must be an integer >= 2, got {args.resolution}")
-    out = Path(args.out)
-    _check_destination(out, "the workspace maps", folder=True)
+    out = check_output(args.out, "the workspace maps", folder=True, argument="out")
     wmap = workspace(model, np.radians(args.phi), args.resolution,
                      min_conditioning=args.min_conditioning)  # fmt: skip
     written = write_workspace(wmap, out)
@@ -660,13 +618,13 @@ def _workspace_summary(wmap: WorkspaceMap) -> str:
 
 def _cmd_sweep(args: argparse.Namespace) -> int:
     from rpr3gen.design import sweep
-    from rpr3gen.design.sweeps import parts_folder
+    from rpr3gen.design.sweeps import SweepInterrupted
 
     try:
         table = sweep(
             args.model,
             args.grid,
-            args.trajectory or DEFAULT_TRAJECTORIES,
+            args.trajectories or DEFAULT_TRAJECTORIES,
             out=args.out,
             scheduler=args.scheduler,
             workers=args.workers,
@@ -678,16 +636,19 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
             duration=args.duration,
             progress=True,
         )
-    except KeyboardInterrupt:
-        if parts_folder(args.out).is_dir():
-            _warn(f"the finished chunks are in {parts_folder(args.out)}: rerun with --resume")
-        raise
+    except SweepInterrupted as exc:  # main prints it as one line: what is kept, how to go on
+        raise KeyboardInterrupt(
+            f"{exc.kept} of {exc.chunks} chunks done, kept in {exc.folder}: rerun with --resume "
+            "to compute only the others"
+        ) from None
     feasible = table.column("feasible").to_numpy(zero_copy_only=False)
     print(f"{table.num_rows} designs, {int(feasible.sum())} feasible; wrote {args.out}")
     return 0
 
 
 def _cmd_generate(args: argparse.Namespace) -> int:
+    if args.out and not args.check:  # before sympy loads: a second, not an hour of work
+        check_output(args.out, "the generated sources", folder=True, argument="out")
     try:
         from rpr3gen_derive.codegen import files as codegen_files
         from rpr3gen_derive.planar import generate, structures
@@ -717,6 +678,8 @@ def _cmd_generate(args: argparse.Namespace) -> int:
         out_dir = Path(args.out) if args.out else generate.default_out_dir()
         if out_dir is None:
             raise Rpr3genError("no source tree's generated/ folder here; name one with --out DIR")
+        if not args.check:
+            check_output(out_dir, "the generated sources", folder=True, argument="out")
         files = generate.render(generate.COMMITTED)
     if args.check:
         stale = codegen_files.stale_files(out_dir, files)
@@ -756,7 +719,12 @@ def _generated_structure(args: argparse.Namespace) -> Structure | None:
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``rpr3gen`` command; returns the exit status."""
     parser = _parser()
-    args = parser.parse_args(argv)
+    try:
+        args = parser.parse_args(argv)
+    except SystemExit as exc:  # a usage error, its line printed: the status (--help exits 0)
+        if exc.code in (0, None):
+            raise
+        return exc.code if isinstance(exc.code, int) else EXIT_ERROR
     if args.command is None:  # a bare `rpr3gen`: show what it can do
         parser.print_help(sys.stderr)
         return EXIT_ERROR
@@ -781,11 +749,15 @@ def main(argv: Sequence[str] | None = None) -> int:
     except (Rpr3genError, OSError) as exc:
         if args.debug:
             raise
-        message = str(exc) if isinstance(exc, Rpr3genError) else _os_message(exc)
+        if isinstance(exc, Rpr3genError):  # "samples: ..." of the Python API is "--samples: ..."
+            message = as_option(exc, subparser(parser, args.command))
+        else:
+            message = _os_message(exc)
         print(f"rpr3gen: error: {message}", file=sys.stderr)
         return EXIT_ERROR
-    except KeyboardInterrupt:
-        print("rpr3gen: interrupted", file=sys.stderr)
+    except KeyboardInterrupt as exc:
+        detail = f"; {exc}" if str(exc) else ""
+        print(f"rpr3gen: interrupted{detail}", file=sys.stderr)
         return 130
 
 

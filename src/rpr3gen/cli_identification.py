@@ -10,37 +10,18 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 from pathlib import Path
 
 import numpy as np
 
 from rpr3gen.atomic import atomic_write
-from rpr3gen.errors import Rpr3genError
+from rpr3gen.cli_args import integer, number
+from rpr3gen.derivatives import MAX_SMOOTHING
 from rpr3gen.model import LEGS, Model, load_model
+from rpr3gen.paths import check_output
 
 EFFORT = {"revolute": "m10", "prismatic": "f21z"}
 UNIT = {"revolute": "N m", "prismatic": "N"}
-
-
-def _positive_int(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not an integer: {text!r}") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"must be >= 1, got {text}")
-    return value
-
-
-def _positive_float(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
-    if not (math.isfinite(value) and value > 0):
-        raise argparse.ArgumentTypeError(f"must be a positive number, got {text}")
-    return value
 
 
 def add_parsers(sub: argparse._SubParsersAction, paper_model: str) -> None:
@@ -68,14 +49,14 @@ def add_parsers(sub: argparse._SubParsersAction, paper_model: str) -> None:
     )
     ide.add_argument(
         "--smoothing",
-        type=float,
+        type=number(least=0.0, most=MAX_SMOOTHING),
         metavar="S",
         help="for a file of positions only: RMS deviation allowed to the smoothing spline "
         "(m, rad; default 0: through every sample; give the measurement noise)",
     )
     ide.add_argument(
         "--max-condition",
-        type=_positive_float,
+        type=number(finite=False, greater=1.0),
         default=MAX_CONDITION,
         metavar="K",
         help=f"refuse data whose condition number exceeds K (default {MAX_CONDITION:g})",
@@ -95,20 +76,27 @@ def add_parsers(sub: argparse._SubParsersAction, paper_model: str) -> None:
     )
     exc.add_argument("--model", metavar="FILE", help=f"model TOML file ({paper_model})")
     exc.add_argument("--out", metavar="FILE.csv", required=True, help="the trajectory CSV")
-    exc.add_argument("--harmonics", type=_positive_int, default=5, help="per coordinate (5)")
-    exc.add_argument("--period", type=_positive_float, default=10.0, help="s (default 10)")
-    exc.add_argument("--samples", type=_positive_int, default=201, help="per period (201)")
+    exc.add_argument(
+        "--harmonics",
+        type=integer(1),
+        default=5,
+        help="per coordinate, at most (samples - 1) / 2 (5)",
+    )
+    exc.add_argument("--period", type=number(greater=0.0), default=10.0, help="s (default 10)")
+    exc.add_argument("--samples", type=integer(10), default=201, help="per period (201)")
     exc.add_argument(
         "--min-conditioning",
-        type=float,
+        type=number(least=0.0, below=1.0),
         default=0.1,
         metavar="C",
         help="floor on the pose's conditioning along the motion (default 0.1)",
     )
     exc.add_argument("--identical-legs", action="store_true", help="optimise for 9 parameters")
     exc.add_argument("--friction", action="store_true", help="include the friction columns")
-    exc.add_argument("--seed", type=int, default=0, help="of the starting motion (0)")
-    exc.add_argument("--max-iterations", type=_positive_int, default=100, help="SLSQP (100)")
+    exc.add_argument("--seed", type=integer(0), default=0, help="of the starting motion (0)")
+    exc.add_argument(
+        "--max-iterations", type=integer(1, 2**31 - 1), default=100, help="SLSQP (100)"
+    )
 
 
 def _toml_value(value: object) -> str:
@@ -169,9 +157,7 @@ def cmd_identify(args: argparse.Namespace) -> int:
 
     model = load_model(args.model)
     if args.out:
-        out = Path(args.out)
-        if out.is_dir():
-            raise Rpr3genError(f"{out}: cannot write the estimates: it is a folder")
+        check_output(args.out, "the estimates", argument="out")
     family = model.structure.effort
     columns = tuple(f"{family}_{leg}" for leg in LEGS)
     traj, tau = read_trajectory_columns(args.data, columns, smoothing=args.smoothing)
@@ -188,6 +174,7 @@ def cmd_identify(args: argparse.Namespace) -> int:
         backend=args.backend,
     )
     if args.out:
+        Path(args.out).parent.mkdir(parents=True, exist_ok=True)
         with atomic_write(args.out) as f:
             f.write(fit_toml(fit, model, args.data))
     unit = UNIT[model.actuation]
@@ -222,9 +209,7 @@ def cmd_excite(args: argparse.Namespace) -> int:
     from rpr3gen.trajectory import write_trajectory_csv
 
     model = load_model(args.model)
-    out = Path(args.out)
-    if out.is_dir():
-        raise Rpr3genError(f"{out}: cannot write the trajectory: it is a folder")
+    out = check_output(args.out, "the trajectory", argument="out")
     found = excite(
         model,
         harmonics=args.harmonics,

@@ -27,8 +27,9 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike
 
-from rpr3gen.backends import evaluate, samples
+from rpr3gen.backends import evaluate
 from rpr3gen.model import LEGS, Model
+from rpr3gen.validation import Reading, Rows, checked
 
 __all__ = [
     "actuator_coordinates",
@@ -51,6 +52,7 @@ POLISH_STEPS = 8
 SAME_MODE = 1e-9
 
 
+@checked()
 def platform_radius(model: Model) -> float:
     """``rho``: the platform's RMS joint radius (m), which turns ``phi`` into a distance."""
     p = model.params
@@ -62,24 +64,28 @@ def platform_radius(model: Model) -> float:
     return math.sqrt(sum(p[x] ** 2 + p[y] ** 2 for x, y in names) / 3)
 
 
+@checked(q=Rows(3))
 def actuator_coordinates(model: Model, q: ArrayLike, backend: str = "numpy") -> np.ndarray:
     """``qa`` of each pose, (n, 3): the actuator part of the inverse kinematics (eq. 5)."""
     (qa,), _ = evaluate(model, "actuator_coordinates", (q,), backend)
     return qa
 
 
+@checked(q=Rows(3))
 def actuator_jacobian(model: Model, q: ArrayLike, backend: str = "numpy") -> np.ndarray:
     """``J = d qa / d q``, (n, 3, 3), so that ``qa' = J q'`` (eq. 6 differentiated)."""
     (J,), _ = evaluate(model, "actuator_jacobian", (q,), backend)
     return J.reshape(-1, 3, 3)
 
 
+@checked(q=Rows(3), qd=Rows(3), same_length=[("q", "qd")])
 def jacobian_rate(model: Model, q: ArrayLike, qd: ArrayLike, backend: str = "numpy") -> np.ndarray:
     """``J' q'``, (n, 3): ``qa'' = J q'' + J' q'`` (eq. 9 at zero platform acceleration)."""
     (rate,), _ = evaluate(model, "jacobian_rate", (q, qd), backend)
     return rate
 
 
+@checked(q=Rows(3), qa_dot=Rows(3), same_length=[("q", "qa_dot")])
 def platform_velocity(
     model: Model, q: ArrayLike, qa_dot: ArrayLike, backend: str = "numpy"
 ) -> np.ndarray:
@@ -89,6 +95,7 @@ def platform_velocity(
     return qd
 
 
+@checked(q=Rows(3), qd=Rows(3), qdd=Rows(3), same_length=[("q", "qd", "qdd")])
 def actuator_efforts(
     model: Model, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, backend: str = "numpy"
 ) -> np.ndarray:
@@ -99,6 +106,7 @@ def actuator_efforts(
     return tau
 
 
+@checked(q=Rows(3), qd=Rows(3), same_length=[("q", "qd")])
 def task_space_dynamics(
     model: Model, q: ArrayLike, qd: ArrayLike, backend: str = "numpy"
 ) -> tuple[np.ndarray, np.ndarray]:
@@ -111,6 +119,7 @@ def task_space_dynamics(
     return M.reshape(-1, 3, 3), c
 
 
+@checked(q=Rows(3), qd=Rows(3), tau=Rows(3), same_length=[("q", "qd", "tau")])
 def forward_dynamics(
     model: Model, q: ArrayLike, qd: ArrayLike, tau: ArrayLike, backend: str = "numpy"
 ) -> np.ndarray:
@@ -180,6 +189,7 @@ def _distinct(model: Model, modes: np.ndarray) -> np.ndarray:
     return np.array(kept).reshape(-1, 3)
 
 
+@checked(qa=Reading(3))
 def assembly_modes(model: Model, qa: ArrayLike, backend: str = "numpy") -> np.ndarray:
     """Every assembly mode of the actuator coordinates ``qa`` (3,): (k, 3) poses, ``phi`` in
     ``(-pi, pi]``, sorted by ``phi``.
@@ -192,7 +202,7 @@ def assembly_modes(model: Model, qa: ArrayLike, backend: str = "numpy") -> np.nd
     ``conditioning`` above ``MIN_CONDITIONING`` (a mode at a parallel singularity, a double one,
     is refused as :func:`rpr3gen.inverse_dynamics` refuses it); joint limits are not applied.
     """
-    row = samples("qa", qa, 3)[0]
+    row = np.asarray(qa)  # (3,) float64: checked
     if model.structure.hold != "circle":
         (modes, margins), _ = evaluate(model, "assembly_modes", (row,), backend)
         # A candidate is a mode where every leg is in its working mode: Newton, from an exact
@@ -217,6 +227,7 @@ def assembly_modes(model: Model, qa: ArrayLike, backend: str = "numpy") -> np.nd
     return modes[np.isfinite(actuator_coordinates(model, modes, backend)).all(axis=1)]
 
 
+@checked(qa=Rows(3), near=Rows(3), same_length=[("qa", "near")])
 def forward_kinematics(
     model: Model, qa: ArrayLike, near: ArrayLike, backend: str = "numpy"
 ) -> np.ndarray:
@@ -228,8 +239,7 @@ def forward_kinematics(
     every mode as a fallback; fast, for control loops). ``"numpy"``: every mode
     (:func:`assembly_modes`), then the nearest.
     """
-    qa = samples("qa", qa, 3)
-    near = samples("near", near, 3)
+    qa, near = np.asarray(qa), np.asarray(near)  # (n, 3) float64 each: checked
     if backend == "c":
         (q,), _ = evaluate(model, "forward_kinematics", (qa, near), backend)
         return q

@@ -18,13 +18,14 @@ from __future__ import annotations
 
 import math
 import warnings
-from numbers import Real
 
 import numpy as np
 
-from rpr3gen.errors import InputError, InputTypeError, TrajectoryError, TrajectoryWarning
+from rpr3gen.errors import TrajectoryError, TrajectoryWarning
+from rpr3gen.validation import Number
 
 __all__ = [
+    "MAX_SMOOTHING",
     "MIN_SAMPLES",
     "MISMATCH_TOLERANCE",
     "SPLINE_DEGREE",
@@ -45,19 +46,19 @@ MISMATCH_TOLERANCE = 0.05
 _POSITION_NAMES = ("x", "y", "phi")
 
 
+MAX_SMOOTHING = 1e100
+"""The largest smoothing (m, rad): far beyond any motion, and ``n smoothing²`` stays a float."""
+
+
 def check_smoothing(smoothing: object) -> float:
-    """Return ``smoothing`` as a float, or raise for a value that is not a number >= 0.
+    """Return ``smoothing`` as a float, or raise for a value that is not a number in
+    ``[0, MAX_SMOOTHING]``.
 
     Raises:
         InputTypeError: If it is not a real number.
-        InputError: If it is negative or not finite.
+        InputError: If it is negative, not finite or above :data:`MAX_SMOOTHING`.
     """
-    if isinstance(smoothing, bool) or not isinstance(smoothing, Real):
-        raise InputTypeError(f"smoothing: must be a number >= 0, got {smoothing!r}")
-    value = float(smoothing)
-    if not (math.isfinite(value) and value >= 0.0):
-        raise InputError(f"smoothing: must be a finite number >= 0, got {smoothing!r}")
-    return value
+    return float(Number(least=0.0, most=MAX_SMOOTHING)("smoothing", smoothing))
 
 
 def differentiate(

@@ -41,7 +41,17 @@ __all__ = [
 
 
 class Rpr3genError(Exception):
-    """Base class of every error the package raises on purpose; ``str(err)`` is one line."""
+    """Base class of every error the package raises on purpose; ``str(err)`` is one line.
+
+    Attributes:
+        argument: the name of the Python argument at fault when the message starts with it
+            (``"samples: ..."``), else None; the command line shows it as its option
+            (``--samples: ...``).
+    """
+
+    def __init__(self, *args: object, argument: str | None = None) -> None:
+        super().__init__(*args)
+        self.argument = argument
 
 
 class ModelError(Rpr3genError, ValueError):

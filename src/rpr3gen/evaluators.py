@@ -11,20 +11,29 @@ particular: both read the manifest.
 
 from __future__ import annotations
 
-import importlib.util
 import itertools
 import os
-import sys
 import threading
 from collections.abc import Sequence
 from concurrent.futures import ThreadPoolExecutor
-from types import ModuleType
 from typing import Protocol
 
 import numpy as np
 
 from rpr3gen.errors import InputError
+from rpr3gen.loader import numpy_module
 from rpr3gen.manifest import FunctionInfo, Variant
+
+__all__ = [
+    "BACKENDS",
+    "CEvaluator",
+    "Evaluator",
+    "NumpyEvaluator",
+    "all_cores",
+    "evaluator",
+    "numpy_module",
+    "thread_count",
+]
 
 BACKENDS: tuple[str, ...] = ("numpy", "c")
 
@@ -86,21 +95,6 @@ class Evaluator(Protocol):
         arrays from :meth:`allocate`, on up to ``threads`` threads. Failed samples hold inf or
         NaN (see :mod:`rpr3gen.policy`). Returns how many failed, when the backend knows."""
         ...
-
-
-def numpy_module(variant: Variant) -> ModuleType:
-    """The generated NumPy module of a variant, imported from its folder."""
-    path = variant.path("numpy")
-    name = f"_rpr3gen_generated_{variant.variant}_{variant.source_hash[:16]}"
-    module = sys.modules.get(name)
-    if module is None or getattr(module, "__file__", None) != str(path):
-        spec = importlib.util.spec_from_file_location(name, path)
-        assert spec is not None
-        assert spec.loader is not None
-        module = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(module)
-        sys.modules[name] = module
-    return module
 
 
 class NumpyEvaluator:

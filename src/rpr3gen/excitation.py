@@ -25,7 +25,7 @@ from functools import lru_cache
 import numpy as np
 import scipy.optimize
 
-from rpr3gen import variants
+from rpr3gen import sizes, variants
 from rpr3gen.backends import evaluate
 from rpr3gen.control import platform_radius
 from rpr3gen.errors import IdentificationError, InputError
@@ -38,6 +38,7 @@ from rpr3gen.identification import (
 from rpr3gen.model import LEGS, Model
 from rpr3gen.policy import joint_limits
 from rpr3gen.trajectory import Trajectory
+from rpr3gen.validation import Integer, Number, Reading, checked
 
 __all__ = ["Excitation", "FourierMotion", "excite"]
 
@@ -124,6 +125,14 @@ def _limits(model: Model) -> list[tuple[str, float, float]]:
     return limits
 
 
+@checked(
+    harmonics=Integer(1),
+    period=Number(greater=0.0, unit="s"),
+    samples=Integer(10),
+    max_acceleration=Reading(2, positive=True),
+    seed=Integer(0),
+    max_iterations=Integer(1, 2**31 - 1),
+)
 @one_blas_thread
 def excite(
     model: Model,
@@ -142,29 +151,33 @@ def excite(
 
     Args:
         model: the robot (geometry, stroke limits; its masses do not matter).
-        harmonics: L, the number of harmonics per coordinate.
+        harmonics: L, the number of harmonics per coordinate, at most ``(samples - 1) // 2``
+            (the samples of a period must resolve the highest harmonic).
         period: T (s), the motion's period; the lowest harmonic is 1/T.
-        samples: samples per period at which the constraints and W are evaluated.
+        samples: samples per period at which the constraints and W are evaluated, >= 10.
         min_conditioning: the floor on ``conditioning`` (1 at best, 0 singular).
-        max_acceleration: the bound on |x''|, |y''| (m/s^2) and on |phi''| (rad/s^2).
+        max_acceleration: the bound on |x''|, |y''| (m/s^2) and on |phi''| (rad/s^2), both > 0.
         identical_legs: optimise for the 9 shared base parameters instead of 19.
         friction: include the friction columns in W.
-        seed: of the random starting coefficients.
+        seed: of the random starting coefficients, >= 0.
         max_iterations: SLSQP's limit.
 
     Raises:
-        InputError: a bad option.
+        InputTypeError, InputError: a bad argument (:mod:`rpr3gen.validation`); sizes beyond
+            the memory limit (:mod:`rpr3gen.sizes`).
         IdentificationError: no feasible starting motion (the central configuration itself
             violates the constraints).
     """
-    if not (isinstance(harmonics, int) and harmonics >= 1):
-        raise InputError(f"harmonics must be an integer >= 1, got {harmonics!r}")
-    if not (isinstance(samples, int) and samples >= 10):
-        raise InputError(f"samples must be an integer >= 10, got {samples!r}")
-    if not (period > 0 and math.isfinite(period)):
-        raise InputError(f"period must be a positive number of seconds, got {period!r}")
-    if not 0 <= min_conditioning < 1:
-        raise InputError(f"min_conditioning must be in [0, 1), got {min_conditioning!r}")
+    if harmonics > (samples - 1) // 2:
+        raise InputError(
+            f"harmonics: {harmonics} harmonics need more than {2 * harmonics} samples per "
+            f"period, got samples = {samples}; at most {(samples - 1) // 2}, or more samples",
+            argument="harmonics",
+        )
+    sizes.check("samples", samples, lambda n: sizes.excite_cost(1, n), "the exciting motion",
+                least=10, argument="samples")  # fmt: skip
+    sizes.check("harmonics", harmonics, lambda h: sizes.excite_cost(h, samples),
+                "the exciting motion's optimisation", least=1, argument="harmonics")  # fmt: skip
     base = base_parameters(model, identical_legs)
     columns = list(base.columns)
     limits = _limits(model)

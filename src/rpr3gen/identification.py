@@ -28,11 +28,12 @@ import scipy.linalg
 from numpy.typing import ArrayLike
 from threadpoolctl import threadpool_limits
 
-from rpr3gen import variants
-from rpr3gen.backends import evaluate, samples
+from rpr3gen import sizes, variants
+from rpr3gen.backends import evaluate
 from rpr3gen.control import actuator_jacobian, platform_radius
 from rpr3gen.errors import IdentificationError, InputError, Rpr3genError
 from rpr3gen.model import LEGS, Model
+from rpr3gen.validation import Number, Optional, Reading, Rows, Sample, checked
 
 __all__ = [
     "INERTIAL_PARAMETER_NAMES",
@@ -116,6 +117,7 @@ def shared_matrix() -> np.ndarray:
     return S
 
 
+@checked()
 def inertial_parameters(model: Model, identical_legs: bool = False) -> np.ndarray:
     """The model's ``pi`` (P,), in the order of :func:`parameter_names`.
 
@@ -183,6 +185,7 @@ def _regressor_and_codes(
     return Y.reshape(-1, 3, len(INERTIAL_PARAMETER_NAMES)), codes
 
 
+@checked(q=Rows(3), qd=Rows(3), qdd=Rows(3), same_length=[("q", "qd", "qdd")])
 def regressor(
     model: Model,
     q: ArrayLike,
@@ -200,6 +203,7 @@ def regressor(
     return Y @ shared_matrix() if identical_legs else Y
 
 
+@checked(q=Rows(3))
 def payload_efforts(model: Model, q: ArrayLike, backend: str = "numpy") -> np.ndarray:
     """``tau_payload`` (n, 3): the efforts holding the model's payload wrench at rest (generated,
     eqs. 12-17 with only the payload acting), which no inertial parameter scales."""
@@ -311,6 +315,7 @@ def _base_parameters(model: Model, identical_legs: bool) -> BaseParameters:
     )
 
 
+@checked()
 def base_parameters(model: Model, identical_legs: bool = False) -> BaseParameters:
     """The base parameters of the model's geometry: Gautier's numerical method.
 
@@ -326,6 +331,7 @@ def base_parameters(model: Model, identical_legs: bool = False) -> BaseParameter
     return _base_parameters(model, bool(identical_legs))
 
 
+@checked(q=Rows(3), qd=Rows(3), qdd=Rows(3), same_length=[("q", "qd", "qdd")])
 def base_regressor(
     model: Model,
     q: ArrayLike,
@@ -401,9 +407,10 @@ class Fit:
     identical_legs: bool = False
     backend: str = "numpy"
 
+    @checked(q=Rows(3), qd=Rows(3), qdd=Rows(3), same_length=[("q", "qd", "qdd")])
     def predict(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> np.ndarray:
         """The efforts (n, 3) the identified parameters give for a motion (with friction)."""
-        q, qd, qdd = (samples(k, v, 3) for k, v in (("q", q), ("qd", qd), ("qdd", qdd)))
+        q, qd, qdd = np.asarray(q), np.asarray(qd), np.asarray(qdd)  # (n, 3) each: checked
         columns = _columns(self.model, q, qd, qdd, self.base, self.friction, self.backend)
         return columns @ self.values + payload_efforts(self.model, q, self.backend)
 
@@ -463,6 +470,16 @@ def _weak_parameters(names: Sequence[str], s: np.ndarray, vt: np.ndarray, limit:
     return ", ".join(n for n in names if n in weak)
 
 
+@checked(
+    q=Rows(3),
+    qd=Rows(3),
+    qdd=Rows(3),
+    tau=Rows(3),
+    weights=Optional(Reading(3, positive=True)),
+    max_condition=Number(finite=False, greater=1.0),
+    t=Optional(Sample()),
+    same_length=[("q", "qd", "qdd", "tau", "t")],
+)
 @one_blas_thread
 def identify(
     model: Model,
@@ -493,7 +510,8 @@ def identify(
         tau: (n, 3) the measured actuator efforts (``m10_*`` or ``f21z_*``).
         friction: also estimate viscous and Coulomb friction per actuator.
         identical_legs: the legs share one set of parameters (B = 9 instead of 19).
-        weights: (3,) the weight of each actuator's rows instead of the automatic ones.
+        weights: (3,) the weight of each actuator's rows instead of the automatic ones
+            (positive; only their ratios count).
         max_condition: the largest condition number accepted (default :data:`MAX_CONDITION`).
         t: (n,) the samples' times, only to name a bad sample in an error.
         backend: ``"numpy"`` or ``"c"`` for the generated regressor.
@@ -504,25 +522,18 @@ def identify(
             parameter (rank-deficient, or condition number above ``max_condition``): the
             message names the parameters left undetermined.
     """
-    q, qd, qdd, tau = (
-        samples(k, v, 3) for k, v in (("q", q), ("qd", qd), ("qdd", qdd), ("tau", tau))
-    )
+    q, qd, qdd, tau = (np.asarray(a) for a in (q, qd, qdd, tau))  # (n, 3) each: checked
+    times = None if t is None else np.asarray(t)  # (n,), finite: checked
     n = q.shape[0]
-    if not (qd.shape[0] == qdd.shape[0] == tau.shape[0] == n):
-        raise InputError(
-            f"q, qd, qdd, tau differ in length: {n}, {len(qd)}, {len(qdd)}, {len(tau)}"
-        )
-    if t is not None:
-        t = np.asarray(t, dtype=float).reshape(-1)
+    sizes.check("q", n, lambda k: k * sizes.IDENTIFY_SAMPLE, "the least-squares problem",
+                unit="samples", argument="q")  # fmt: skip
 
     def where(i: int) -> str:
-        return f"sample {i + 1}" + (f" (t = {t[i]:g} s)" if t is not None and len(t) == n else "")
+        return f"sample {i + 1}" + (f" (t = {times[i]:g} s)" if times is not None else "")
 
     bad = np.flatnonzero(~np.isfinite(tau).all(axis=1))
     if bad.size:
-        raise InputError(f"tau: {where(int(bad[0]))}: an effort is not finite")
-    if not (isinstance(max_condition, (int, float)) and max_condition > 1):
-        raise InputError(f"max_condition must be a number > 1, got {max_condition!r}")
+        raise InputError(f"tau: {where(int(bad[0]))}: an effort is not finite", argument="tau")
     base = base_parameters(model, identical_legs)
     Y, codes = _regressor_and_codes(model, q, qd, qdd, backend)
     bad = np.flatnonzero(codes != 0)
@@ -564,9 +575,8 @@ def identify(
         w = np.where(sigma > 0, 1.0 / np.where(sigma > 0, sigma, 1.0), 1.0)
         w = w / w.max()
     else:
-        w = np.asarray(weights, dtype=float).reshape(-1)
-        if w.shape != (3,) or not (np.isfinite(w).all() and (w > 0).all()):
-            raise InputError(f"weights must be 3 positive numbers, got {weights!r}")
+        w = np.asarray(weights)  # (3,), positive and finite: checked
+        w = w / w.max()  # only their ratios count; so none overflows the weighted rows
     x, W, y = solve(w)
     weighted = y - W @ x
     sigma2 = float(weighted @ weighted) / (3 * n - p)

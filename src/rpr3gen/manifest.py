@@ -101,6 +101,14 @@ class Variant:
         return self.folder / self.files[role]
 
 
+def regenerate_hint(folder: Path) -> str:
+    """How to make a generated folder anew: ``rpr3gen generate --out FOLDER``, or for the
+    installed package, reinstalling (or ``rpr3gen generate`` in a source tree)."""
+    if folder.resolve() == default_folder().resolve():
+        return "reinstall rpr3gen, or run `rpr3gen generate` in its source tree"
+    return f"regenerate it: rpr3gen generate --out {folder}"
+
+
 def default_folder() -> Path:
     """Folder of the installed generated package ``rpr3gen_generated``."""
     return Path(str(resources.files("rpr3gen_generated")))
@@ -154,38 +162,60 @@ def _function(data: dict, codes: dict[str, int], thresholds: dict[str, float]) -
 @cache
 def _load(folder: Path, variant: str) -> Variant:
     path = folder / variant / "manifest.json"
+    hint = regenerate_hint(folder)
     try:
         data = json.loads(path.read_text(encoding="utf-8"))
     except FileNotFoundError:
         found = ", ".join(available(folder)) or "none"
         raise Rpr3genError(
-            f"{path}: no generated variant {variant!r} here (variants found: {found}); "
-            "run `rpr3gen generate`"
+            f"{path}: no generated variant {variant!r} here (variants found: {found}); {hint}"
         ) from None
-    except (OSError, ValueError) as exc:
-        raise Rpr3genError(f"{path}: unreadable manifest: {exc}") from None
-    if data.get("format") != FORMAT:
+    except UnicodeDecodeError as exc:
+        raise Rpr3genError(f"{path}: not UTF-8 text (byte {exc.start}); {hint}") from None
+    except ValueError as exc:
+        raise Rpr3genError(f"{path}: not JSON ({exc}); {hint}") from None
+    except OSError as exc:
+        raise Rpr3genError(f"{path}: cannot read it: {exc.strerror or exc}; {hint}") from None
+    found_format = data.get("format") if isinstance(data, dict) else None
+    if found_format != FORMAT:
         raise Rpr3genError(
-            f"{path}: manifest format {data.get('format')!r}, this runtime reads {FORMAT}; "
-            "regenerate with this version (`rpr3gen generate`)"
+            f"{path}: manifest format {found_format!r}, this runtime reads {FORMAT}; {hint}"
         )
+    try:
+        return _variant(folder, variant, data)
+    except KeyError as exc:
+        raise Rpr3genError(
+            f"{path}: damaged: no key {exc.args[0]!r} where one is needed; {hint}"
+        ) from None
+    except (TypeError, ValueError, AttributeError, StopIteration) as exc:
+        raise Rpr3genError(
+            f"{path}: damaged: {type(exc).__name__}: {exc or 'a value of the wrong kind'}; {hint}"
+        ) from None
+
+
+def _variant(folder: Path, variant: str, data: dict) -> Variant:
+    """The :class:`Variant` of a parsed manifest (KeyError, TypeError... when damaged)."""
     codes = {c["name"]: int(c["value"]) for c in data["return_codes"]}
     thresholds = {t["name"]: float(t["value"]) for t in data["thresholds"]}
-    return Variant(
+    found = Variant(
         folder=folder / variant,
-        prefix=data["prefix"],
-        variant=data["variant"],
-        source_hash=data["source_hash"],
-        files=dict(data["files"]),
-        param_names=tuple(p["name"] for p in data["params"]),
+        prefix=str(data["prefix"]),
+        variant=str(data["variant"]),
+        source_hash=str(data["source_hash"]),
+        files={str(k): str(v) for k, v in dict(data["files"]).items()},
+        param_names=tuple(str(p["name"]) for p in data["params"]),
         return_codes=codes,
-        code_meanings={int(c["value"]): c["meaning"] for c in data["return_codes"]},
+        code_meanings={int(c["value"]): str(c["meaning"]) for c in data["return_codes"]},
         thresholds=thresholds,
         functions={f["name"]: _function(f, codes, thresholds) for f in data["functions"]},
         tables={
             name: tuple(c["name"] for c in comps) for name, comps in data.get("tables", {}).items()
         },
     )
+    missing = [role for role in ("numpy", "c_header", "c_source") if role not in found.files]
+    if missing:
+        raise KeyError(f"files.{missing[0]}")
+    return found
 
 
 def load(variant: str, generated: str | os.PathLike[str] | None = None) -> Variant:

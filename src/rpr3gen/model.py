@@ -26,9 +26,10 @@ from typing import Any, NoReturn
 
 import numpy as np
 
-from rpr3gen import manifest
-from rpr3gen.errors import ModelError, Rpr3genError, did_you_mean
+from rpr3gen.errors import ModelError, did_you_mean
+from rpr3gen.model_checks import check_fields
 from rpr3gen.structure import PAPER_PARAM_NAMES, Structure
+from rpr3gen.validation import Instance, Optional, PathArg, checked
 
 __all__ = [
     "ACTUATIONS",
@@ -140,40 +141,13 @@ class Model:
     limits: Mapping[str, tuple[float, float]] | None = None
 
     def __post_init__(self) -> None:
-        if self.structure is None or self.structure.paper:
-            # The paper's format: its actuation picks the variant (dataclasses.replace of
-            # actuation alone switches it).
-            if self.actuation not in ACTUATIONS:
-                raise ModelError(
-                    f"{self.source}: actuation: must be one of {_quoted(ACTUATIONS)}, "
-                    f"got {_describe(self.actuation)}"
-                )
-            object.__setattr__(self, "structure", Structure.of_variant(self.actuation))
-        elif self.actuation != self.structure.actuation:
-            raise ModelError(
-                f"{self.source}: actuation: a {self.structure.title} has "
-                f"{self.structure.actuation} motors, not {_describe(self.actuation)}"
-            )
-        names = self.structure.param_names()
-        if set(self.params) != set(names):
-            missing = [n for n in names if n not in self.params]
-            extra = sorted(set(self.params) - set(names))
-            raise ModelError(f"{self.source}: params: missing {missing}, unexpected {extra}")
-        ordered = _ReadOnlyParams({n: float(self.params[n]) for n in names})
-        object.__setattr__(self, "params", ordered)
+        fields = check_fields(self, ACTUATIONS)  # rpr3gen.model_checks
+        object.__setattr__(self, "structure", fields["structure"])
+        object.__setattr__(self, "params", _ReadOnlyParams(fields["params"]))
+        object.__setattr__(self, "stroke", fields["stroke"])
+        object.__setattr__(self, "generated", fields["generated"])
         if self.limits is not None:
             object.__setattr__(self, "limits", _ReadOnlyLimits(self.limits))
-        if self.generated is not None:
-            object.__setattr__(self, "generated", os.fspath(self.generated))
-            try:
-                variant = manifest.load(self.variant, self.generated)
-            except Rpr3genError as exc:
-                raise ModelError(f"generated code: {exc}") from None
-            if variant.param_names != names:
-                raise ModelError(
-                    f"{variant.folder}: generated for other model parameters than this "
-                    "runtime's; regenerate it with this version"
-                )
 
     @property
     def variant(self) -> str:
@@ -221,6 +195,7 @@ class _ReadOnlyLimits(Mapping[str, tuple[float, float]]):
         return f"{type(self).__name__}({self._data!r})"
 
 
+@checked(path=Optional(PathArg()), generated=Optional(PathArg()))
 def load_model(
     path: str | os.PathLike[str] | None = None,
     generated: str | os.PathLike[str] | None = None,
@@ -283,6 +258,7 @@ def read_model_data(path: str | os.PathLike[str] | None = None) -> tuple[str, di
     return source, data
 
 
+@checked(data=Instance(Mapping, "a mapping (the parsed TOML)"), source=Instance(str, "a str"))
 def model_from_dict(data: Mapping[str, Any], source: str = "<dict>") -> Model:
     """Validate a model given as nested mappings (the parsed TOML) and build the :class:`Model`.
 

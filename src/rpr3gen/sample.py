@@ -21,6 +21,7 @@ from rpr3gen import policy, variants
 from rpr3gen.errors import InputError, Rpr3genError
 from rpr3gen.evaluators import evaluator
 from rpr3gen.model import Model
+from rpr3gen.validation import Instance, Reading, checked
 
 
 class SampleEvaluator:
@@ -35,10 +36,17 @@ class SampleEvaluator:
     were; :attr:`codes` maps each code to its meaning (from the manifest).
     """
 
+    @checked(function=Instance(str, "the name of a generated function"))
     def __init__(self, model: Model, backend: str = "c", function: str = "inverse_dynamics"):
         self.model = model
         self.backend = backend
         variant = variants.load(model.structure, model.generated)
+        if function not in variant.functions:
+            known = ", ".join(variant.functions)
+            raise InputError(
+                f"function: no generated function {function!r} (there are: {known})",
+                argument="function",
+            )
         self.function = variant.function(function)
         self.codes = dict(variant.code_meanings)
         self.params = np.ascontiguousarray(model.vector(variant.param_names))
@@ -73,9 +81,11 @@ class SampleEvaluator:
     def evaluate(self, *inputs: ArrayLike) -> np.ndarray:
         """Copy a sample in, evaluate, and return the first output; raise on a non-zero code."""
         if len(inputs) != len(self.inputs):
-            raise InputError(f"{self.function.name} takes {len(self.inputs)} inputs")
-        for buffer, value in zip(self.inputs.values(), inputs, strict=True):
-            buffer[:] = value
+            names = ", ".join(self.inputs)
+            raise InputError(f"inputs: {self.function.name} takes {len(self.inputs)} ({names}), "
+                             f"got {len(inputs)}", argument="inputs")  # fmt: skip
+        for (name, buffer), value in zip(self.inputs.items(), inputs, strict=True):
+            buffer[:] = Reading(buffer.size)(name, value)
         status = self()
         if status:
             first = next(iter(self.inputs))

@@ -23,14 +23,17 @@ from typing import TextIO
 
 import numpy as np
 
+from rpr3gen import sizes
 from rpr3gen.atomic import write_csv_table
-from rpr3gen.derivatives import check_smoothing, differentiate, mismatch
-from rpr3gen.errors import InputTypeError, TrajectoryError, TrajectoryWarning, did_you_mean
+from rpr3gen.derivatives import MAX_SMOOTHING, check_smoothing, differentiate, mismatch
+from rpr3gen.errors import TrajectoryError, TrajectoryWarning, did_you_mean
+from rpr3gen.validation import Instance, Integer, Number, Optional, PathArg, checked, numbers
 
 __all__ = [
     "CSV_COLUMNS",
     "DEFAULT_DURATION",
     "DEFAULT_SAMPLES",
+    "DURATIONS",
     "PAPER_TRAJECTORIES",
     "POSITION_COLUMNS",
     "Trajectory",
@@ -59,6 +62,10 @@ DEFAULT_SAMPLES = 301
 DEFAULT_DURATION = 3.0
 """Duration of the paper's motions, s (Δt of eq. 3)."""
 
+DURATIONS: tuple[float, float] = (1e-6, 1e9)
+"""The durations a paper trajectory may have, s: from a microsecond (accelerations ~1e11 m/s²)
+to 30 years; beyond, its loads and their squares leave float64's range."""
+
 
 @dataclass(frozen=True, eq=False)
 class Trajectory:
@@ -77,17 +84,26 @@ class Trajectory:
     qdd: np.ndarray
 
     def __post_init__(self) -> None:
-        t = np.array(self.t, dtype=np.float64)
+        t = np.array(numbers("t", self.t, TrajectoryError))  # InputTypeError: not numbers
         if t.ndim != 1 or t.size == 0:
             raise TrajectoryError(f"trajectory: t must have shape (n,) with n >= 1, got {t.shape}")
         for name in ("t", "q", "qd", "qdd"):
-            value = t if name == "t" else np.array(getattr(self, name), dtype=np.float64)
+            value = (
+                t if name == "t" else np.array(numbers(name, getattr(self, name), TrajectoryError))
+            )
             if name != "t" and value.shape != (t.size, 3):
                 raise TrajectoryError(
-                    f"trajectory: {name} must have shape ({t.size}, 3), got {value.shape}"
+                    f"trajectory: {name} must have shape ({t.size}, 3), a row per time of t, "
+                    f"got {value.shape}"
                 )
             value.setflags(write=False)
             object.__setattr__(self, name, value)
+        if not np.isfinite(t).all() or (np.diff(t) <= 0).any():
+            k = int(np.flatnonzero(~np.isfinite(t) | np.r_[False, np.diff(t) <= 0])[0])
+            raise TrajectoryError(
+                f"trajectory: t must be finite and strictly increasing, got t[{k}] = {t[k]:g}"
+                + (f" after {t[k - 1]:g}" if k else "")
+            )
 
     def __len__(self) -> int:
         """Number of samples."""
@@ -115,6 +131,7 @@ class Trajectory:
                 or fewer than 6 samples.
             InputTypeError, InputError: For a ``smoothing`` that is not a number >= 0.
         """
+        Instance(str, "a name for messages")("source", source)
         given = cls(t=t, q=q, qd=q, qdd=q)  # shapes checked, float64 copies
         if not (np.isfinite(given.t).all() and np.isfinite(given.q).all()):
             raise TrajectoryError(f"{source}: t and q must be finite")
@@ -124,6 +141,12 @@ class Trajectory:
         return cls(t=given.t, q=q_fit, qd=qd, qdd=qdd)
 
 
+@checked(
+    name=Instance(str, "'rotation' or 'rectilinear'"),
+    samples=Integer(2, cost=lambda n: n * sizes.PAPER_SAMPLE, what="the trajectory",
+                    error=TrajectoryError),
+    duration=Number(least=DURATIONS[0], most=DURATIONS[1], unit="s", error=TrajectoryError),
+)  # fmt: skip
 def paper_trajectory(
     name: str, samples: int = DEFAULT_SAMPLES, duration: float = DEFAULT_DURATION
 ) -> Trajectory:
@@ -135,7 +158,7 @@ def paper_trajectory(
     Args:
         name: ``"rotation"`` or ``"rectilinear"`` (keys of :data:`PAPER_TRAJECTORIES`).
         samples: Number of samples, at least 2, equally spaced including both ends.
-        duration: Length of the motion, s, finite and positive (the paper: 3 s).
+        duration: Length of the motion, s, in :data:`DURATIONS` (the paper: 3 s).
 
     Raises:
         TrajectoryError: For an unknown name, ``samples < 2`` or a ``duration`` not finite and
@@ -145,32 +168,28 @@ def paper_trajectory(
     if name not in PAPER_TRAJECTORIES:
         hint = did_you_mean(str(name), PAPER_TRAJECTORIES)
         choices = " or ".join(PAPER_TRAJECTORIES)
-        raise TrajectoryError(f"unknown trajectory {name!r}: choose {choices}{hint}")
-    if isinstance(samples, bool) or not isinstance(samples, int | np.integer):
-        raise InputTypeError(f"samples: must be an integer >= 2, got {samples!r}")
-    if samples < 2:
-        raise TrajectoryError(f"samples: must be an integer >= 2, got {samples!r}")
-    if isinstance(duration, bool) or not isinstance(
-        duration, int | float | np.integer | np.floating
-    ):
-        raise InputTypeError(f"duration: must be a finite number of seconds > 0, got {duration!r}")
-    if not math.isfinite(duration) or duration <= 0:
-        raise TrajectoryError(f"duration: must be a finite number of seconds > 0, got {duration!r}")
+        raise TrajectoryError(
+            f"name: unknown trajectory {name!r}: choose {choices}{hint}", argument="name"
+        )
 
     amplitude = np.array(PAPER_TRAJECTORIES[name], dtype=np.float64)
     t = np.linspace(0.0, float(duration), int(samples))
     w = math.pi / float(duration)
-    s = 1.0 - np.cos(w * t)
-    sd = w * np.sin(w * t)
-    sdd = w * w * np.cos(w * t)
-    return Trajectory(
-        t=t,
-        q=np.outer(s, amplitude),
-        qd=np.outer(sd, amplitude),
-        qdd=np.outer(sdd, amplitude),
-    )
+    with np.errstate(over="ignore", invalid="ignore"):
+        s = 1.0 - np.cos(w * t)
+        sd = w * np.sin(w * t)
+        sdd = w * w * np.cos(w * t)
+        q, qd, qdd = (np.outer(x, amplitude) for x in (s, sd, sdd))
+    if not (np.isfinite(qd).all() and np.isfinite(qdd).all() and (np.diff(t) > 0).all()):
+        raise TrajectoryError(
+            f"duration: {duration!r} s is too short for {samples} samples: the times or the "
+            "accelerations are beyond float64",
+            argument="duration",
+        )
+    return Trajectory(t=t, q=q, qd=qd, qdd=qdd)
 
 
+@checked(path=PathArg(), smoothing=Optional(Number(least=0.0, most=MAX_SMOOTHING)))
 def read_trajectory_csv(
     path: str | os.PathLike[str], *, smoothing: float | None = None
 ) -> Trajectory:

@@ -4,15 +4,25 @@ Each chunk is one task; results come back to this process as they finish, in any
 progress bar (tqdm, on stderr when it is a terminal) counts the designs done. Dask's own
 ``progress`` does not fit: in a terminal it blocks until every task is done and writes to
 stdout, and this loop must write each chunk as it arrives.
+
+**Ctrl-C** (the one interrupt path): a terminal sends SIGINT to every process of the command,
+the local cluster's workers too, which would die mid-task with tracebacks. So the workers start
+with SIGINT blocked (:func:`_workers_deaf_to_ctrl_c`); only this process sees it. It then keeps
+every chunk that has finished (:func:`_keep_finished`), cancels the rest and shuts the cluster
+down with Dask's loggers silenced and further Ctrl-C ignored until it is down
+(:meth:`ClusterClient.close_quietly`), and raises ``KeyboardInterrupt``.
 """
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import os
+import signal
 import sys
+import threading
 import uuid
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Iterator
 from typing import Any
 
 from rpr3gen.design.metrics import SweepPlan
@@ -63,14 +73,31 @@ def run_chunks(
                 client.submit(task, shared, index, key=f"rpr3gen-sweep-{run}-{index}")
                 for index in todo
             ]
+            kept: set[int] = set()
             try:
                 for future in as_completed(futures):
                     index, columns = task_result(future)
                     done(index, columns)
+                    kept.add(index)
                     bar.update(len(plan.chunk(index)))
                     future.release()
+            except KeyboardInterrupt:
+                _keep_finished(futures, todo, kept, done)
+                raise
             finally:
-                client.cancel(futures)
+                with contextlib.suppress(Exception):
+                    client.cancel(futures)
+
+
+def _keep_finished(
+    futures: list[Any], todo: list[int], kept: set[int], done: Callable[[int, Columns], None]
+) -> None:
+    """On Ctrl-C: hand every chunk whose task had finished, and was not yet kept, to ``done``
+    (its result is on the cluster already), so that a resumed sweep finds all of them."""
+    for index, future in zip(todo, futures, strict=True):
+        if index not in kept and future.status == "finished":
+            with contextlib.suppress(Exception):
+                done(*future.result(timeout=5))
 
 
 def task_result(future: Any) -> tuple[int, Columns]:
@@ -106,25 +133,102 @@ class ClusterClient:
                 raise Rpr3genError(f"scheduler {self.address}: cannot connect: {exc}") from None
             return self.client
         n = self.workers or len(os.sched_getaffinity(0))
-        with dask.config.set({MALLOC_TRIM: None}):
-            self.cluster = LocalCluster(
-                n_workers=n,
-                threads_per_worker=1,
-                processes=True,
-                dashboard_address=None,
-                # No dashboard, and its health routes on a free port, not on 8787: that one may
-                # be another cluster's (Dask warns, then takes another).
-                scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
-                silence_logs=logging.ERROR,
-            )
-        self.client = Client(self.cluster)
+        try:
+            with dask.config.set({MALLOC_TRIM: None}), _workers_deaf_to_ctrl_c():
+                self.cluster = LocalCluster(
+                    n_workers=n,
+                    threads_per_worker=1,
+                    processes=True,
+                    dashboard_address=None,
+                    # No dashboard, and its health routes on a free port, not on 8787: that one
+                    # may be another cluster's (Dask warns, then takes another).
+                    scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
+                    silence_logs=logging.ERROR,
+                )
+                self.client = Client(self.cluster)
+        except BaseException:  # Ctrl-C while starting, delivered once the workers are up
+            self.close_quietly()
+            raise
         return self.client
 
-    def __exit__(self, *exc: object) -> None:
+    def __exit__(self, kind: type[BaseException] | None, *exc: object) -> None:
+        if kind is not None and issubclass(kind, KeyboardInterrupt):
+            self.close_quietly()
+            return
         if self.client is not None:
             self.client.close()
         if self.cluster is not None:
             self.cluster.close()
+
+    def close_quietly(self) -> None:
+        """Shut the client and the local cluster down after a Ctrl-C: Dask's loggers (tasks
+        cancelled, connections closed) silenced, a second Ctrl-C ignored until it is done."""
+        with _silenced("distributed", "tornado", "asyncio"), _ctrl_c_ignored():
+            for closing in (self.client, self.cluster):
+                if closing is not None:
+                    with contextlib.suppress(Exception):
+                        closing.close(timeout=10)
+
+
+def _main_thread() -> bool:
+    return threading.current_thread() is threading.main_thread()
+
+
+@contextlib.contextmanager
+def _workers_deaf_to_ctrl_c() -> Iterator[None]:
+    """Start processes deaf to SIGINT (a terminal's Ctrl-C reaches every process of the
+    command) without losing one meant for this process, nor raising it halfway through.
+
+    SIGINT is blocked in this thread, so in the threads Dask starts meanwhile (its event loop,
+    which spawns the workers), so in the workers: a process keeps its parent thread's mask, and
+    Python does not unblock it (multiprocessing's resource tracker would, so it is started
+    first). A Ctrl-C meanwhile, delivered to a thread that does not block
+    it (BLAS's) or pending until the block ends, is only recorded, and raised as
+    ``KeyboardInterrupt`` once the block ends, when the cluster is up and can be shut down.
+    """
+    if not _main_thread() or not hasattr(signal, "pthread_sigmask"):
+        yield
+        return
+    # Started now, multiprocessing's resource tracker cannot unblock SIGINT later: starting it
+    # blocks and then unblocks SIGINT in the thread that spawns, whatever it was before.
+    from multiprocessing import resource_tracker
+
+    resource_tracker.ensure_running()
+    caught: list[int] = []
+    previous = signal.signal(signal.SIGINT, lambda number, frame: caught.append(number))
+    signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})  # a pending one raises here
+    if caught:
+        raise KeyboardInterrupt
+
+
+@contextlib.contextmanager
+def _ctrl_c_ignored() -> Iterator[None]:
+    if not _main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+@contextlib.contextmanager
+def _silenced(*names: str) -> Iterator[None]:
+    loggers = [logging.getLogger(name) for name in names]
+    levels = [logger.level for logger in loggers]
+    for logger in loggers:
+        logger.setLevel(logging.CRITICAL + 1)
+    try:
+        yield
+    finally:
+        for logger, level in zip(loggers, levels, strict=True):
+            logger.setLevel(level)
 
 
 class _ProgressBar:

@@ -41,6 +41,7 @@ from typing import Any
 
 import numpy as np
 
+from rpr3gen import sizes
 from rpr3gen.errors import GridError, ModelError, did_you_mean
 from rpr3gen.general_model import LEG_KEYS, is_general
 from rpr3gen.model import ACTUATIONS, DEFAULT_GRAVITY, MODEL_KEYS, Model, model_from_dict
@@ -370,6 +371,8 @@ def _range(key: str, given: Mapping[str, Any], source: str) -> tuple[float, ...]
     num = given["num"]
     if isinstance(num, bool) or not isinstance(num, int) or num < 1:
         raise GridError(f"{source}: {key}.num: must be an integer >= 1, got {_show(num)}")
+    sizes.check(f"{source}: {key}.num", num, lambda n: n * sizes.DESIGN_ROW,
+                "the grid's designs", least=1, error=GridError)  # fmt: skip
     return tuple(float(v) for v in np.linspace(start, stop, num))
 
 

@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from rpr3gen import sizes
 from rpr3gen.design.reach import (
     Limit,
     bounds,
@@ -29,9 +30,9 @@ from rpr3gen.design.reach import (
     within,
 )
 from rpr3gen.design.stacked import evaluate_stacked, leg_lengths, piston_displacements
-from rpr3gen.errors import InputError, InputTypeError
 from rpr3gen.model import LEGS, Model
 from rpr3gen.policy import DEFAULT_MIN_CONDITIONING
+from rpr3gen.validation import Integer, Number, checked
 
 __all__ = [
     "BISECTIONS",
@@ -192,22 +193,17 @@ def _spacing(centres: np.ndarray) -> float:
     return float(centres[1] - centres[0]) if centres.size > 1 else 0.0
 
 
-def _check(phi: float, resolution: int, min_conditioning: float) -> None:
-    if isinstance(resolution, bool) or not isinstance(resolution, int | np.integer):
-        raise InputTypeError(f"resolution: must be an integer >= 2, got {resolution!r}")
-    if resolution < 2:
-        raise InputError(f"resolution: must be an integer >= 2, got {resolution!r}")
-    if not math.isfinite(phi):
-        raise InputError(f"phi: must be a finite angle (rad), got {phi!r}")
-    if not 0.0 <= min_conditioning < 1.0:
-        raise InputError(f"min_conditioning: must be in [0, 1), got {min_conditioning!r}")
-
-
 def cell_centres(lo: float, hi: float, n: int) -> np.ndarray:
     """``n`` centres of equal cells between ``lo`` and ``hi``."""
     return lo + (np.arange(n) + 0.5) * ((hi - lo) / n)
 
 
+@checked(
+    phi=Number(unit="rad"),
+    resolution=Integer(
+        2, cost=lambda n: n * n * sizes.WORKSPACE_POINT, what="the workspace map's points"
+    ),
+)
 def workspace(
     model: Model,
     phi: float = 0.0,
@@ -225,14 +221,13 @@ def workspace(
         model: the design, of either format (its limits, or the defaults of
             :func:`rpr3gen.design.reach.design_limits`).
         phi: platform angle, rad.
-        resolution: grid points along each axis, at least 2.
+        resolution: grid points along each axis, at least 2, at most what the memory limit
+            allows (:mod:`rpr3gen.sizes`: about 2 KiB a point).
         min_conditioning: the least ``conditioning`` counted reachable, in [0, 1).
 
     Raises:
-        InputError, InputTypeError: for a bad argument.
+        InputError, InputTypeError: for a bad argument (:mod:`rpr3gen.validation`).
     """
-    _check(phi, resolution, min_conditioning)
-    phi = float(phi)
     params = model.vector()
     limits = design_limits(model)
     bound = bounds(limits)

@@ -238,8 +238,8 @@ def _trajectory_metrics(
         for leg in LEGS:
             tau = get(f"{effort}_{leg}")
             results[f"peak_tau_{leg}"][at] = _peak(tau)
-            power = np.where(ok, tau, 0.0) ** 2
-            with np.errstate(invalid="ignore", divide="ignore"):
+            with np.errstate(invalid="ignore", divide="ignore", over="ignore"):  # inf: too large
+                power = np.where(ok, tau, 0.0) ** 2
                 results[f"rms_tau_{leg}"][at] = np.sqrt((power * w).sum(axis=1) / total)
         if structure.paper:
             for family in JOINT_FAMILIES:

@@ -26,14 +26,21 @@ from rpr3gen import manifest, variants
 from rpr3gen.design.cluster import run_chunks
 from rpr3gen.design.grid import read_grid
 from rpr3gen.design.metrics import SweepPlan, evaluate_chunk
+from rpr3gen.design.sweep_checks import (
+    ARGUMENTS,
+    check_memory,
+    check_paper_samples,
+    check_values,
+)
 from rpr3gen.errors import (
     InputError,
-    InputTypeError,
     Rpr3genError,
     TrajectoryError,
     did_you_mean,
 )
+from rpr3gen.evaluators import all_cores
 from rpr3gen.model import ACTUATIONS, model_from_dict, read_model_data
+from rpr3gen.paths import check_output
 from rpr3gen.policy import DEFAULT_MIN_CONDITIONING
 from rpr3gen.structure import Structure
 from rpr3gen.trajectory import (
@@ -43,11 +50,13 @@ from rpr3gen.trajectory import (
     Trajectory,
     paper_trajectory,
 )
+from rpr3gen.validation import checked
 
 __all__ = [
     "DEFAULT_AREA_RESOLUTION",
     "DEFAULT_CHUNK_SIZE",
     "DEFAULT_TRAJECTORIES",
+    "SweepInterrupted",
     "parts_folder",
     "sweep",
 ]
@@ -67,11 +76,29 @@ _FORMAT = 1
 Columns = dict[str, Any]
 
 
+class SweepInterrupted(KeyboardInterrupt):
+    """Ctrl-C during a sweep that writes a file: how many chunks are done and kept, and where.
+
+    Attributes:
+        kept: chunks done, in ``folder``.
+        chunks: chunks of the sweep.
+        folder: the parts folder, which ``resume=True`` continues from.
+    """
+
+    def __init__(self, kept: int, chunks: int, folder: Path) -> None:
+        super().__init__(
+            f"{kept} of {chunks} chunks done, kept in {folder}: resume=True computes only the "
+            "others"
+        )
+        self.kept, self.chunks, self.folder = kept, chunks, folder
+
+
 def parts_folder(out: str | os.PathLike[str]) -> Path:
     """Where a sweep writing ``out`` keeps its finished chunks: ``out`` + ``.parts``."""
     return Path(f"{os.fspath(out)}.parts")
 
 
+@checked(ARGUMENTS)
 def sweep(
     model: str | os.PathLike[str] | Mapping[str, Any] | None = None,
     grid: str | os.PathLike[str] | Mapping[str, Any] | None = None,
@@ -120,21 +147,24 @@ def sweep(
         Rpr3genError: an interrupted sweep's chunks are in the way (without ``resume``), or
             they belong to another sweep.
     """
+    if out is None and resume:
+        raise InputError("resume: needs out, the file whose chunks are resumed", argument="resume")
+    if out is not None:
+        target = check_output(out, "the sweep", argument="out")
+        check_output(parts_folder(target), "the sweep's parts", folder=True, argument="out")
+    local = scheduler is None and workers != 0
+    processes = (workers or all_cores()) if local else 1 if scheduler is None else 0
     plan = make_plan(model, grid, trajectories, chunk_size=chunk_size,
                      min_conditioning=min_conditioning, area_resolution=area_resolution,
-                     samples=samples, duration=duration)  # fmt: skip
-    _check_workers(workers)
+                     samples=samples, duration=duration, processes=processes,
+                     workers=workers)  # fmt: skip
     if out is None:
-        if resume:
-            raise InputError("resume: needs out, the file whose chunks are resumed")
         parts: dict[int, Columns] = {}
         run_chunks(plan, range(plan.chunks), evaluate_chunk, parts.__setitem__, scheduler, workers,
                    progress)  # fmt: skip
         return _joined(_table(parts[i]) for i in range(plan.chunks))
     from rpr3gen.design import parquet
 
-    target = Path(out)
-    _check_destination(target)
     folder = _open_parts(plan, parts_folder(target), resume)
 
     def keep(index: int, columns: Columns) -> None:
@@ -147,6 +177,8 @@ def sweep(
         run_chunks(plan, todo, evaluate_chunk, keep, scheduler, workers, progress, initial=initial)
     except Rpr3genError as exc:
         raise Rpr3genError(f"{exc}; the chunks done are in {folder}: rerun with --resume") from exc
+    except KeyboardInterrupt as exc:
+        raise SweepInterrupted(len(_done_chunks(plan, folder)), plan.chunks, folder) from exc
     target.parent.mkdir(parents=True, exist_ok=True)
     parquet.write_tables(target, (folder / _part_name(i) for i in range(plan.chunks)))
     shutil.rmtree(folder)
@@ -163,23 +195,29 @@ def make_plan(
     area_resolution: int = DEFAULT_AREA_RESOLUTION,
     samples: int = DEFAULT_SAMPLES,
     duration: float = DEFAULT_DURATION,
+    processes: int = 1,
+    workers: int | None = None,
 ) -> SweepPlan:
-    """Check every input and build the :class:`SweepPlan` (no work yet)."""
-    if grid is None:
-        raise InputError("grid: give a grid file or a mapping {dotted model key: values}")
-    _positive_int("chunk_size", chunk_size, least=1)
-    _positive_int("area_resolution", area_resolution, least=0)
-    if area_resolution == 1:
-        raise InputError("area_resolution: must be 0 (no area) or an integer >= 2, got 1")
-    if not 0.0 <= min_conditioning < 1.0:
-        raise InputError(f"min_conditioning: must be in [0, 1), got {min_conditioning!r}")
+    """Check every input and build the :class:`SweepPlan` (no work yet).
+
+    ``processes``: how many tasks run at once on this machine (local workers, or 1 in this
+    process, 0 on a remote cluster), for the memory check
+    (:func:`rpr3gen.design.sweep_checks.check_memory`); ``workers``:
+    the argument that set them, to name in its message (None: one per core).
+    """
+    check_values(grid, chunk_size, area_resolution, samples, duration, min_conditioning)
+    assert grid is not None  # checked
     if isinstance(model, Mapping):
         source, base = "<model>", dict(model)
     else:
         source, base = read_model_data(model)
     model_from_dict(base, source=source)  # the base itself must be valid
     checked = read_grid(grid, base)
+    papers = sum(isinstance(t, str) and t in PAPER_TRAJECTORIES for t in trajectories)
+    check_paper_samples(samples, papers)
     names, trajs = _trajectories(trajectories, samples, duration)
+    check_memory(checked, sum(len(t) for t in trajs), chunk_size, area_resolution, processes,
+                 workers)  # fmt: skip
     return SweepPlan(
         base=base,
         base_source=source,
@@ -190,18 +228,6 @@ def make_plan(
         area_resolution=int(area_resolution),
         chunk_size=int(chunk_size),
     )
-
-
-def _positive_int(name: str, value: Any, least: int) -> None:
-    if isinstance(value, bool) or not isinstance(value, int | np.integer):
-        raise InputTypeError(f"{name}: must be an integer >= {least}, got {value!r}")
-    if value < least:
-        raise InputError(f"{name}: must be an integer >= {least}, got {value!r}")
-
-
-def _check_workers(workers: int | None) -> None:
-    if workers is not None:
-        _positive_int("workers", workers, least=0)
 
 
 def _trajectories(
@@ -224,8 +250,9 @@ def _trajectories(
             if path.suffix.lower() != ".csv" and not path.exists():
                 hint = did_you_mean(str(item), PAPER_TRAJECTORIES)
                 raise TrajectoryError(
-                    f"--trajectory: {os.fspath(item)!r} is neither "
-                    f"{', '.join(PAPER_TRAJECTORIES)} nor a CSV file{hint}"
+                    f"trajectories: {os.fspath(item)!r} is neither "
+                    f"{', '.join(PAPER_TRAJECTORIES)} nor a CSV file{hint}",
+                    argument="trajectories",
                 )
             names.append(path.stem)
             trajs.append(read_trajectory_csv(path))
@@ -272,16 +299,6 @@ def _generated(plan: SweepPlan) -> dict[str, str]:
         structure = Structure(base.leg, joint)
         found[structure.variant] = variants.load(structure).source_hash
     return found
-
-
-def _check_destination(target: Path) -> None:
-    if target.is_dir():
-        raise Rpr3genError(f"{target}: cannot write the sweep: it is a folder")
-    for part in target.parents:
-        if part.exists():
-            if not part.is_dir():
-                raise Rpr3genError(f"{target}: cannot write the sweep: {part} is a file")
-            return
 
 
 def _open_parts(plan: SweepPlan, folder: Path, resume: bool) -> Path:

@@ -333,7 +333,9 @@ def lower_numpy(
             state.drop(lhs)
     for name, expr in outputs:
         row = output_rows[name]
-        if expr.is_Symbol and alias.get(expr) == row:
+        # An aliased intermediate was computed in its row, unless it is a parameter-only
+        # scalar (computed once as a Python number): that row is filled here.
+        if expr.is_Symbol and alias.get(expr) == row and expr not in state.scalars:
             continue
         state.emit(expr, row)
     return LoweredNumpy(scalar_lines, state.lines, state.count, bool(pairs))

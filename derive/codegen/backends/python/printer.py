@@ -18,6 +18,20 @@ class NumpyPrinter(NumPyPrinter):
     def __init__(self) -> None:
         super().__init__({"fully_qualified_modules": True, "inline": True})
 
+    def _print_Min(self, expr: sp.Expr) -> str:
+        return self._fold("fmin", expr.args)
+
+    def _print_Max(self, expr: sp.Expr) -> str:
+        return self._fold("fmax", expr.args)
+
+    def _fold(self, ufunc: str, args: tuple[sp.Expr, ...]) -> str:
+        """``numpy.fmin(a, numpy.fmin(b, c))``: pairwise, as the lowering and the C fold them
+        (a NaN argument is ignored, as C99's fmin does), needing no other import."""
+        text = self._print(args[-1])
+        for arg in reversed(args[:-1]):
+            text = f"numpy.{ufunc}({self._print(arg)}, {text})"
+        return text
+
     def _print_wrap_angle(self, expr: sp.Expr) -> str:
         x = self._print(expr.args[0])
         return f"(({x}) - {TWO_PI}*numpy.rint(({x})*{INV_TWO_PI}))"
