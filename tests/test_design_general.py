@@ -463,3 +463,33 @@ def test_a_default_travel_is_named_as_such_in_the_reason() -> None:
         r"model file\)",
         row["reason"],
     ), row["reason"]
+
+
+def test_stacked_designs_fall_back_to_one_call_per_design(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Generated code that takes one parameter vector only (a parameter-only output written by
+    ``fill``, the 3-PPR's reach) raises ValueError on stacked columns: each design's run of
+    columns is then evaluated alone, with the same values."""
+    from rpr3gen.design.stacked import evaluate_stacked, param_rows
+    from rpr3gen.evaluators import NumpyEvaluator
+
+    grid = read_grid({"legs.A.joints[1][0]": [0.17, 0.18, 0.19]}, RRR)
+    models = [model_from_dict(grid.apply(RRR, grid.design(i))) for i in range(len(grid))]
+    traj = rpr3gen.paper_trajectory("rectilinear", samples=11)
+    params = np.repeat(param_rows(models), 11, axis=1)
+    inputs = [np.tile(a, (3, 1)) for a in (traj.q, traj.qd, traj.qdd)]
+    stacked = evaluate_stacked(models[0], "inverse_dynamics", params, inputs)
+    run = NumpyEvaluator.run
+    calls = []
+
+    def one_vector_only(self: Any, info: Any, p: np.ndarray, *args: Any, **kw: Any) -> Any:
+        calls.append(p.shape)
+        if p.ndim == 2 and np.any(p != p[:, :1]):
+            raise ValueError("setting an array element with a sequence.")
+        return run(self, info, p, *args, **kw)
+
+    monkeypatch.setattr(NumpyEvaluator, "run", one_vector_only)
+    alone = evaluate_stacked(models[0], "inverse_dynamics", params, inputs)
+    assert calls == [params.shape, (params.shape[0],), (params.shape[0],), (params.shape[0],)]
+    np.testing.assert_array_equal(alone.codes, stacked.codes)
+    for name, values in stacked.values.items():
+        np.testing.assert_allclose(alone[name], values, rtol=1e-13, atol=1e-12, err_msg=name)

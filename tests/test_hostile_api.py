@@ -541,8 +541,10 @@ APIS: tuple[Api, ...] = (
     ),
     _api(
         "Model",
-        good=lambda tmp: {f.name: getattr(MODEL, f.name) for f in dataclasses.fields(MODEL)}
-        | {"params": dict(MODEL.params)},
+        good=lambda tmp: (
+            {f.name: getattr(MODEL, f.name) for f in dataclasses.fields(MODEL)}
+            | {"params": dict(MODEL.params)}
+        ),
         kinds={
             "name": Kind(
                 "name",
