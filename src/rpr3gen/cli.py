@@ -186,7 +186,7 @@ def _parser() -> argparse.ArgumentParser:
     ws = sub.add_parser(
         "workspace",
         help="workspace and singularity maps of a design at a fixed platform angle",
-        description="Map the positions of G reachable at the platform angle PHI (strokes, "
+        description="Map the positions of G reachable at the platform angle PHI (joint limits, "
         "conditioning), the conditioning with the singularity curves, the static actuator "
         "efforts holding the robot at rest and the reachable orientation range; write "
         "DIR/workspace.parquet and four PNG figures.",
@@ -595,18 +595,22 @@ def _cmd_workspace(args: argparse.Namespace) -> int:
 
 def _workspace_summary(wmap: WorkspaceMap) -> str:
     reachable = int(np.count_nonzero(wmap.reachable))
-    strokes = ", ".join(f"[{lo:.4g}, {hi:.4g}]" for lo, hi in wmap.stroke)
+    if wmap.stroke is not None:
+        strokes = ", ".join(f"[{lo:.4g}, {hi:.4g}]" for lo, hi in wmap.stroke)
+        limits = f"strokes lambda21 {strokes} m"
+    else:
+        limits = wmap.limits_text(unicode=False)
     lines = [
         f"workspace of {wmap.model.name} at phi = {np.degrees(wmap.phi):g} deg: "
         f"{wmap.x.size} x {wmap.y.size} points, x {wmap.x[0]:.4g} to {wmap.x[-1]:.4g} m, "
         f"y {wmap.y[0]:.4g} to {wmap.y[-1]:.4g} m",
-        f"  reachable: {reachable} points, area {wmap.area:.5g} m^2 (strokes lambda21 {strokes} "
-        f"m; conditioning >= {wmap.min_conditioning:g})",
+        f"  reachable: {reachable} points, area {wmap.area:.5g} m^2 ({limits}; "
+        f"conditioning >= {wmap.min_conditioning:g})",
     ]
     if reachable:
         peak = float(np.nanmax(np.abs(wmap.tau)))
         width = np.degrees(np.nanmax(wmap.phi_max - wmap.phi_min))
-        unit = "N m" if wmap.effort == "m10" else "N"
+        unit = wmap.effort_unit.replace("·", " ")
         lines.append(f"  peak static |{wmap.effort}|: {peak:.5g} {unit}; widest orientation "
                      f"range: {width:.4g} deg")  # fmt: skip
     return "\n".join(lines)

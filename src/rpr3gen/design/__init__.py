@@ -6,8 +6,9 @@
   (:mod:`.metrics`), in chunks (:mod:`.sweeps`) on Dask (:mod:`.cluster`), as Parquet
   (:mod:`.parquet`).
 
-Both evaluate the generated NumPy code with one parameter vector per sample
-(:mod:`.stacked`), and count a pose reachable as :mod:`.reach` says.
+Both take a model of either format (the paper's 3-RPR, or the general one of any leg type),
+evaluate the generated NumPy code with one parameter vector per sample (:mod:`.stacked`), and
+count a pose reachable as :mod:`.reach` says (with its default limits for design studies).
 """
 
 from rpr3gen.design.maps import WorkspaceMap, workspace

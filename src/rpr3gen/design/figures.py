@@ -12,7 +12,7 @@ import math
 import os
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 from matplotlib import patheffects
@@ -85,25 +85,53 @@ def _outline(ax: Axes, wmap: WorkspaceMap, color: str = "k") -> list[Line2D]:
 
 
 def _pivots(ax: Axes, wmap: WorkspaceMap) -> list[Line2D]:
-    """The base pivots A1, B1, C1 (inside the box or not; the axes keep the grid's limits)."""
-    p = wmap.model.params
+    """The base pivots A1, B1, C1 (inside the box or not; the axes keep the grid's limits); a
+    general model's base joints at home and the rails of prismatic ones, in the legend when
+    they are in the map."""
+    x0, x1, y0, y1 = _extent(wmap)
+    general = not wmap.model.structure.paper
+    slide = general and wmap.model.structure.leg[0] == "P"
+    rails = [_rail(wmap, leg) for leg in LEGS] if slide else []
     handles = []
-    for leg in LEGS:
+    if any(_inside((x0, x1, y0, y1), *rail) for rail in rails):  # one entry, legs' colours
+        handles.append(Line2D([], [], color="0.5", linewidth=3.0, alpha=0.6,
+                              label="rails (travel of A1, B1, C1)"))  # fmt: skip
+    for k, (leg, x, y) in enumerate(wmap.base_points()):
+        if slide:
+            ax.plot(*rails[k], color=LEG_COLORS[leg], linewidth=3.0, alpha=0.6,
+                    solid_capstyle="butt")  # fmt: skip
         (h,) = ax.plot(
-            p[f"x{leg}1"],
-            p[f"y{leg}1"],
+            x,
+            y,
             marker="^",
             markersize=9,
             linestyle="none",
             color=LEG_COLORS[leg],
             markeredgecolor="k",
-            label=f"base pivot {leg}1",
+            label=f"slide {leg}1 at home" if slide else f"base pivot {leg}1",
         )
-        handles.append(h)
-    x0, x1, y0, y1 = _extent(wmap)
+        if not general or _inside((x0, x1, y0, y1), [x], [y]):
+            handles.append(h)
     ax.set_xlim(x0, x1)
     ax.set_ylim(y0, y1)
     return handles
+
+
+def _inside(box: tuple[float, float, float, float], xs: list[float], ys: list[float]) -> bool:
+    """Some point of the polyline ``xs, ys`` (sampled) is inside ``box``."""
+    t = np.linspace(0.0, 1.0, 65)[:, np.newaxis]
+    points = np.column_stack([xs, ys])
+    path = points[:-1] + t[..., np.newaxis] * np.diff(points, axis=0) if len(xs) > 1 else points
+    px, py = np.reshape(path, (-1, 2)).T
+    return bool(np.any((px >= box[0]) & (px <= box[1]) & (py >= box[2]) & (py <= box[3])))
+
+
+def _rail(wmap: WorkspaceMap, leg: str) -> tuple[list[float], list[float]]:
+    """The segment that a general model's prismatic base joint ``leg`` 1 travels along."""
+    p = wmap.model.params
+    lo, hi = next((lo, hi) for k, family, lo, hi in wmap.limits if (k, family) == (leg, "q1"))
+    x, y, ux, uy = (p[f"{c}1_{leg}"] for c in ("x", "y", "ux", "uy"))
+    return [x + lo * ux, x + hi * ux], [y + lo * uy, y + hi * uy]
 
 
 def reachable_figure(wmap: WorkspaceMap) -> Figure:
@@ -112,16 +140,15 @@ def reachable_figure(wmap: WorkspaceMap) -> Figure:
     cmap = ListedColormap(["#f2f2f2", "#4c8bc9"])
     _image(ax, wmap, wmap.reachable.astype(float), cmap=cmap, vmin=0.0, vmax=1.0)
     handles = _outline(ax, wmap) + _pivots(ax, wmap)
-    strokes = ", ".join(f"[{lo:.3g}, {hi:.3g}]" for lo, hi in wmap.stroke)
-    ax.text(0.01, 0.01, f"strokes λ21 (m): {strokes}; conditioning ≥ {wmap.min_conditioning:g}",
+    ax.text(0.01, 0.01, f"{wmap.limits_text()}; conditioning ≥ {wmap.min_conditioning:g}",
             transform=ax.transAxes, fontsize="small", va="bottom")  # fmt: skip
     _legend(fig, handles)
     return fig
 
 
 def conditioning_figure(wmap: WorkspaceMap) -> Figure:
-    """Conditioning heat map with the parallel (conditioning 0) and serial (stroke limit)
-    singularity curves."""
+    """Conditioning heat map with the parallel singularity (conditioning 0) and the joint limits
+    (the paper's strokes: its serial singularities)."""
     fig, ax = _frame(wmap, "Conditioning and singularity curves")
     image = _image(ax, wmap, wmap.conditioning, cmap="viridis", vmin=0.0, vmax=1.0)
     fig.colorbar(image, ax=ax, label="conditioning (0 = parallel singularity)", shrink=0.8)
@@ -131,15 +158,23 @@ def conditioning_figure(wmap: WorkspaceMap) -> Figure:
         ax.contour(wmap.x, wmap.y, signed, levels=[0.0], colors="red", linewidths=2.0)
         handles.append(Line2D([], [], color="red", linewidth=2.0,
                               label="parallel singularity (conditioning 0)"))  # fmt: skip
-    for k, leg in enumerate(LEGS):
-        lam = np.ma.masked_invalid(wmap.lambda21[..., k])
-        lo, hi = wmap.stroke[k]
+    drawn: set[str] = set()
+    for k, (leg, family, lo, hi) in enumerate(wmap.limits):
+        lam = np.ma.masked_invalid(wmap.coordinates[..., k])
         levels = [v for v in (lo, hi) if lam.count() and lam.min() < v < lam.max()]
         if levels:
+            style: Literal["--", ":"] = (
+                "--" if family in ("lambda21", wmap.model.structure.actuator) else ":"
+            )
             ax.contour(wmap.x, wmap.y, lam, levels=levels, colors=LEG_COLORS[leg],
-                       linestyles="--", linewidths=1.5)  # fmt: skip
-            handles.append(Line2D([], [], color=LEG_COLORS[leg], linestyle="--",
-                                  label=f"stroke limit, leg {leg}"))  # fmt: skip
+                       linestyles=style, linewidths=1.5)  # fmt: skip
+            if family == "lambda21":  # the paper's: one entry per leg
+                handles.append(Line2D([], [], color=LEG_COLORS[leg], linestyle=style,
+                                      label=f"stroke limit, leg {leg}"))  # fmt: skip
+            elif family not in drawn:  # one entry per coordinate, in the legs' colours
+                drawn.add(family)
+                handles.append(Line2D([], [], color="0.3", linestyle=style,
+                                      label=f"limit of {family}, each leg"))  # fmt: skip
     handles += _outline(ax, wmap, color="white")
     handles += _pivots(ax, wmap)
     _legend(fig, handles)
@@ -148,7 +183,7 @@ def conditioning_figure(wmap: WorkspaceMap) -> Figure:
 
 def effort_figure(wmap: WorkspaceMap) -> Figure:
     """The largest static actuator effort of the three legs at each reachable point."""
-    unit = _UNITS[wmap.effort]
+    unit = wmap.effort_unit
     fig, ax = _frame(wmap, f"Peak static effort max |{wmap.effort}| over legs A, B, C")
     peak = np.max(np.abs(wmap.tau), axis=2)
     finite = peak[np.isfinite(peak) & (peak > 0)]

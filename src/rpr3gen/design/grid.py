@@ -10,6 +10,18 @@ A grid file (TOML) sets dotted model keys to their values, a list or a range wit
 Tables are dotted keys too (``[mass]`` then ``m3 = [...]`` is ``"mass.m3"``). The designs are
 every combination, in the order of the keys, the last key fastest (``itertools.product``).
 
+A base model of the general format (any leg type) has its own keys::
+
+    "platform.mass" = [2.0, 4.0]                # platform.inertia, payload.moment
+    "legs.A.mass[1]" = [0.5, 1.0]               # one element of a leg's list
+    "legs.A.joints[1][0]" = [0.15, 0.2]         # one coordinate of a point (joint 2's x)
+    "legs.B.axes[0][1]" = [0.0, 0.1]            # a prismatic joint's axis
+    "environment.gravity[1]" = [-9.81, -1.62]   # platform.com[i], payload.force[i]
+    "limits.q2[1]" = [0.2, 0.3]                 # a bound the base model's [limits] holds
+    actuated = [1, 2]                           # the motors' joint
+
+With ``symmetric = true`` only leg A's keys exist (legs B and C are leg A turned).
+
 Every key and every value is checked before any work: an unknown key (with the close match), a
 value that is not a list or a range, or a value that makes the base model invalid is a
 :class:`~rpr3gen.errors.GridError` naming the file and the key.
@@ -31,7 +43,9 @@ import numpy as np
 
 from rpr3gen import sizes
 from rpr3gen.errors import GridError, ModelError, did_you_mean
+from rpr3gen.general_model import LEG_KEYS, is_general
 from rpr3gen.model import ACTUATIONS, DEFAULT_GRAVITY, MODEL_KEYS, Model, model_from_dict
+from rpr3gen.structure import LEGS
 
 __all__ = ["Grid", "read_grid"]
 
@@ -44,14 +58,29 @@ LIST_SHAPES: Mapping[str, tuple[int, ...]] = {
     "payload.force": (2,),
     "limits.stroke": (3, 2),
 }
+#: The general format's keys that hold a list, with its shape (``L``: a leg).
+GENERAL_LIST_SHAPES: Mapping[str, tuple[int, ...]] = {
+    "legs.L.joints": (3, 2),
+    "legs.L.axes": (3, 2),
+    "legs.L.mass": (2,),
+    "legs.L.com": (2, 2),
+    "legs.L.inertia": (2,),
+    "platform.com": (2,),
+    "environment.gravity": (2,),
+    "payload.force": (2,),
+}
+#: The general format's keys that hold one number.
+GENERAL_SCALARS: tuple[str, ...] = ("platform.mass", "platform.inertia", "payload.moment")
 #: Lists a model may leave out, and the value they then have.
 _LIST_DEFAULTS: Mapping[str, Any] = {
     "environment.gravity": list(DEFAULT_GRAVITY),
     "payload.force": [0.0, 0.0],
+    "platform.com": [0.0, 0.0],
 }
 #: Model keys that are not design parameters.
-_NOT_PARAMETERS = ("name",)
+_NOT_PARAMETERS = ("name", "leg", "symmetric")
 _TEXT_KEYS = ("actuation",)
+_INTEGER_KEYS = ("actuated",)
 _RANGE_KEYS = ("start", "stop", "num")
 _KEY = re.compile(r"^(?P<key>[A-Za-z_][A-Za-z0-9_.]*?)(?P<index>(\[\d+\])*)$")
 
@@ -90,7 +119,7 @@ class Grid:
         where = np.unravel_index(np.arange(start, stop), self.shape)
         columns = {}
         for key, values, k in zip(self.keys, self.values, where, strict=True):
-            kind = object if key in _TEXT_KEYS else np.float64
+            kind = object if key in _TEXT_KEYS else np.int64 if key in _INTEGER_KEYS else np.float64
             columns[key] = np.array(values, dtype=kind)[k]
         return columns
 
@@ -129,8 +158,9 @@ def read_grid(grid: str | os.PathLike[str] | Mapping[str, Any], base: Mapping[st
             f'{source}: no keys; set model keys to values, e.g. "geometry.r" = [0.25, 0.3]'
         )
     keys, values = [], []
+    check = _check_general_key if is_general(base) else _check_key
     for key, given in flat.items():
-        _check_key(key, base, source)
+        check(key, base, source)
         keys.append(key)
         values.append(_values(key, given, source))
     grid_ = Grid(keys=tuple(keys), values=tuple(values), source=source)
@@ -209,23 +239,92 @@ def _check_key(key: str, base: Mapping[str, Any], source: str) -> None:
         if index:
             raise GridError(f"{source}: {key}: {name} holds one value, not a list")
         return
-    if len(index) != len(shape):
-        example = name + "".join("[0]" for _ in shape)
-        raise GridError(f'{source}: {key}: {name} holds a list; vary one element, e.g. "{example}"')
-    for i, n in zip(index, shape, strict=True):
-        if i >= n:
-            raise GridError(f"{source}: {key}: index {i} out of range (0 to {n - 1})")
+    _check_index(key, name, index, shape, source)
     if _get(base, name) is None and name not in _LIST_DEFAULTS:
         raise GridError(
             f"{source}: {key}: the base model has no {name} to vary; set it in the model file"
         )
 
 
+def general_keys(base: Mapping[str, Any]) -> tuple[str, ...]:
+    """Every key a grid may vary on a base model of the general format (without indices):
+    those of :data:`GENERAL_LIST_SHAPES` (leg A's alone with ``symmetric = true``),
+    :data:`GENERAL_SCALARS`, ``actuated`` and each ``limits`` key the base model holds."""
+    legs = ("A",) if base.get("symmetric") is True else LEGS
+    keys = [k.replace("L", leg, 1) for k in GENERAL_LIST_SHAPES if k.startswith("legs.")
+            for leg in legs]  # fmt: skip
+    keys += [k for k in GENERAL_LIST_SHAPES if not k.startswith("legs.")]
+    keys += [*GENERAL_SCALARS, "actuated"]
+    limits = base.get("limits")
+    if isinstance(limits, Mapping):
+        keys += [f"limits.{k}" for k in limits]
+    return tuple(keys)
+
+
+def _general_shape(name: str) -> tuple[int, ...] | None:
+    parts = name.split(".")
+    if name.startswith("limits."):
+        return (2,)
+    if len(parts) == 3 and parts[0] == "legs":
+        return GENERAL_LIST_SHAPES.get(f"legs.L.{parts[2]}")
+    return GENERAL_LIST_SHAPES.get(name)
+
+
+def _check_general_key(key: str, base: Mapping[str, Any], source: str) -> None:
+    name, index = _split(key)
+    if name in _NOT_PARAMETERS:
+        raise GridError(f"{source}: {key}: not a design parameter")
+    known = general_keys(base)
+    if name not in known:
+        parts = name.split(".")
+        if len(parts) == 3 and parts[0] == "legs" and parts[1] in LEGS and parts[2] in LEG_KEYS:
+            raise GridError(
+                f"{source}: {key}: with symmetric = true only leg A's keys exist (legs B and C "
+                f"are leg A turned by 120 and 240 degrees); vary legs.A.{parts[2]}"
+            )
+        if parts[0] == "limits" and len(parts) > 1:
+            raise GridError(
+                f"{source}: {key}: the base model has no {name} to vary; set it in the "
+                f"model file's [limits]"
+            )
+        hint = did_you_mean(name, known)
+        raise GridError(f"{source}: {key}: unknown model key{hint}")
+    shape = _general_shape(name)
+    if shape is None:
+        if index:
+            raise GridError(f"{source}: {key}: {name} holds one value, not a list")
+        return
+    _check_index(key, name, index, shape, source)
+    if name.endswith(".axes"):
+        leg = base.get("leg")
+        if isinstance(leg, str) and len(leg) == 3 and leg[index[0]] == "R":
+            raise GridError(
+                f"{source}: {key}: joint {index[0] + 1} of a 3-{leg} is revolute; its axis "
+                "is ignored"
+            )
+    if _get(base, name) is None and name not in _LIST_DEFAULTS:
+        raise GridError(
+            f"{source}: {key}: the base model has no {name} to vary; set it in the model file"
+        )
+
+
+def _check_index(
+    key: str, name: str, index: tuple[int, ...], shape: tuple[int, ...], source: str
+) -> None:
+    if len(index) != len(shape):
+        example = name + "".join("[0]" for _ in shape)
+        raise GridError(f'{source}: {key}: {name} holds a list; vary one element, e.g. "{example}"')
+    for i, n in zip(index, shape, strict=True):
+        if i >= n:
+            raise GridError(f"{source}: {key}: index {i} out of range (0 to {n - 1})")
+
+
 def _values(key: str, given: Any, source: str) -> tuple[Any, ...]:
     text = key in _TEXT_KEYS
     if _is_range(given):
-        if text:
-            raise GridError(f"{source}: {key}: a range needs numbers; give a list of values")
+        if text or key in _INTEGER_KEYS:
+            what = "numbers" if text else "numbers; actuated takes joints 1, 2 or 3"
+            raise GridError(f"{source}: {key}: a range needs {what}; give a list of values")
         return _range(key, given, source)
     if not isinstance(given, list):
         raise GridError(
@@ -246,6 +345,12 @@ def _values(key: str, given: Any, source: str) -> tuple[Any, ...]:
                     f"got {_show(value)}{hint}"
                 )
             out.append(value)
+        elif key in _INTEGER_KEYS:
+            if isinstance(value, bool) or value not in (1, 2, 3):
+                raise GridError(
+                    f"{source}: {key}[{i}]: must be the joint 1, 2 or 3, got {_show(value)}"
+                )
+            out.append(int(value))
         else:
             out.append(_number(f"{key}[{i}]", value, source))
     return tuple(out)
@@ -291,16 +396,31 @@ def _show(value: Any) -> str:
     return repr(value)
 
 
+def _path(name: str) -> list[str]:
+    """The tables and the key of a dotted model key: ``"legs.A.mass"`` -> ``["legs", "A",
+    "mass"]``; a ``[limits]`` key keeps its dot (``"limits.A.q2"`` -> ``["limits", "A.q2"]``)."""
+    if name.startswith("limits."):
+        return ["limits", name[len("limits.") :]]
+    return name.split(".")
+
+
 def _get(data: Mapping[str, Any], name: str) -> Any:
-    table, _, key = name.rpartition(".")
-    inner = data.get(table, {}) if table else data
-    return inner.get(key) if isinstance(inner, Mapping) else None
+    inner: Any = data
+    for part in _path(name):
+        if not isinstance(inner, Mapping):
+            return None
+        inner = inner.get(part)
+    return inner
 
 
 def _set(data: dict[str, Any], key: str, value: Any) -> None:
     name, index = _split(key)
-    table, _, leaf = name.rpartition(".")
-    inner = data.setdefault(table, {}) if table else data
+    *tables, leaf = _path(name)
+    inner = data
+    for table in tables:  # copied on the way: the base model's tables are never changed
+        child = inner.get(table)
+        inner[table] = dict(child) if isinstance(child, Mapping) else {}
+        inner = inner[table]
     if not index:
         inner[leaf] = value
         return

@@ -20,9 +20,12 @@ import numpy as np
 
 from rpr3gen import sizes
 from rpr3gen.design.reach import (
-    design_stroke,
+    Limit,
+    bounds,
+    coordinates,
+    design_limits,
     jacobian_sign,
-    pose_extent,
+    pose_box,
     reachable_signed,
     within,
 )
@@ -74,38 +77,60 @@ class WorkspaceMap:
         model: the design.
         phi: the platform angle of the map, rad.
         min_conditioning: the least ``conditioning`` counted reachable.
-        stroke: the strokes used, ``((lo, hi), ...)`` of legs A, B, C (m).
+        limits: the bounded joint coordinates used, ``(leg, family, lo, hi)``
+            (:func:`rpr3gen.design.reach.design_limits`: the paper's strokes on ``lambda21``,
+            a general model's ``[limits]`` and the default travel of its prismatic joints).
         x: (nx,) positions of G along x0, the centres of the grid's cells (m).
         y: (ny,) along y0 (m).
         reachable: bool.
         conditioning: the generated ``conditioning`` of the pose, 0 at a parallel singularity
-            and 1 at best, wherever every leg has a length (NaN elsewhere), reachable or not.
+            and 1 at best, wherever every leg reaches the pose (the paper's format: wherever
+            every leg has a length; NaN elsewhere), reachable or not.
         jacobian_sign: the sign of ``det J`` (the actuator Jacobian): it changes across a
             parallel singularity, where ``conditioning`` touches 0.
-        lambda21: (ny, nx, 3) piston displacement of each leg (m).
-        tau: (ny, nx, 3) static actuator efforts ``m10`` (N m) or ``f21z`` (N) of legs A, B, C
-            holding the robot at rest, NaN where not reachable.
+        coordinates: (ny, nx, k) the bounded joint coordinates, in the order of ``limits``
+            (m or rad; NaN, or anything, where a leg does not reach the pose).
+        tau: (ny, nx, 3) static actuator efforts of legs A, B, C holding the robot at rest
+            (``tau``, or the paper's ``m10`` (N m) or ``f21z`` (N)), NaN where not reachable.
         phi_min, phi_max: the reachable interval of platform angles through the point that
             contains ``phi`` (rad), NaN where not reachable; at most half a turn each way.
+        effort: the output family of ``tau``: ``m10``, ``f21z`` or ``tau``.
     """
 
     model: Model
     phi: float
     min_conditioning: float
-    stroke: tuple[tuple[float, float], ...]
+    limits: tuple[Limit, ...]
     x: np.ndarray
     y: np.ndarray
     reachable: np.ndarray
     conditioning: np.ndarray
     jacobian_sign: np.ndarray
-    lambda21: np.ndarray
+    coordinates: np.ndarray
     tau: np.ndarray
     phi_min: np.ndarray
     phi_max: np.ndarray
     effort: str = field(init=False)
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "effort", "m10" if self.model.actuation == "revolute" else "f21z")
+        object.__setattr__(self, "effort", self.model.structure.effort)
+
+    @property
+    def effort_unit(self) -> str:
+        """``N·m`` (motors on revolute joints) or ``N`` (on prismatic joints)."""
+        return "N·m" if self.model.structure.actuated_kind == "R" else "N"
+
+    @property
+    def stroke(self) -> tuple[tuple[float, float], ...] | None:
+        """The paper's format: the strokes ``((lo, hi), ...)`` of legs A, B, C (m); else None."""
+        if not self.model.structure.paper:
+            return None
+        return tuple((lo, hi) for _, _, lo, hi in self.limits)
+
+    @property
+    def lambda21(self) -> np.ndarray | None:
+        """The paper's format: (ny, nx, 3) piston displacement of each leg (m); else None."""
+        return self.coordinates if self.model.structure.paper else None
 
     @property
     def cell_area(self) -> float:
@@ -116,6 +141,36 @@ class WorkspaceMap:
     def area(self) -> float:
         """Reachable area (m²): the reachable cells times their area."""
         return float(np.count_nonzero(self.reachable)) * self.cell_area
+
+    def limits_text(self, unicode: bool = True) -> str:
+        """The limits in a line: ``strokes λ21 (m): [lo, hi], ...`` (the paper's format), or
+        ``limits q1 [-0.25, 0.25] m`` per coordinate, once for the three legs when they show
+        the same bounds (else ``q1_A [...] m, q1_B ...``)."""
+        if self.model.structure.paper:
+            strokes = ", ".join(f"[{lo:.3g}, {hi:.3g}]" for _, _, lo, hi in self.limits)
+            return f"strokes {'λ21' if unicode else 'lambda21'} (m): {strokes}"
+        if not self.limits:
+            return "no joint limits"
+        by_family: dict[str, list[Limit]] = {}
+        for limit in self.limits:
+            by_family.setdefault(limit[1], []).append(limit)
+        parts = []
+        for family, found in by_family.items():
+            unit = "rad" if self.model.structure.leg[int(family[1]) - 1] == "R" else "m"
+            shown = {leg: f"[{lo:.3g}, {hi:.3g}] {unit}" for leg, _, lo, hi in found}
+            if len(shown) == len(LEGS) and len(set(shown.values())) == 1:
+                parts.append(f"{family} {shown[LEGS[0]]}")
+            else:
+                parts += [f"{family}_{leg} {text}" for leg, text in shown.items()]
+        return "limits " + ", ".join(parts)
+
+    def base_points(self) -> list[tuple[str, float, float]]:
+        """``(leg, x, y)``: each leg's base joint (the paper's pivot A1; a general model's joint
+        1 at home)."""
+        p = self.model.params
+        if self.model.structure.paper:
+            return [(leg, p[f"x{leg}1"], p[f"y{leg}1"]) for leg in LEGS]
+        return [(leg, p[f"x1_{leg}"], p[f"y1_{leg}"]) for leg in LEGS]
 
     def columns(self) -> dict[str, np.ndarray]:
         """The grid as the columns :data:`COLUMNS`, one row per point, x fastest."""
@@ -159,12 +214,12 @@ def workspace(
     """The workspace map of ``model`` at the platform angle ``phi``.
 
     The grid has ``resolution`` x ``resolution`` cells over the box that holds every position
-    reachable at ``phi`` (:func:`rpr3gen.design.reach.pose_extent`); each point is a cell's
+    reachable at ``phi`` (:func:`rpr3gen.design.reach.pose_box`); each point is a cell's
     centre.
 
     Args:
-        model: the design (its ``[limits] stroke``, or the default of
-            :func:`rpr3gen.design.reach.design_stroke`).
+        model: the design, of either format (its limits, or the defaults of
+            :func:`rpr3gen.design.reach.design_limits`).
         phi: platform angle, rad.
         resolution: grid points along each axis, at least 2, at most what the memory limit
             allows (:mod:`rpr3gen.sizes`: about 2 KiB a point).
@@ -174,24 +229,29 @@ def workspace(
         InputError, InputTypeError: for a bad argument (:mod:`rpr3gen.validation`).
     """
     params = model.vector()
-    stroke = np.array(design_stroke(model))
-    x0, x1, y0, y1 = pose_extent(params, phi, stroke[:, 1])
-    if not (x0 < x1 and y0 < y1):  # nothing reachable: show where the legs could be
-        x0, x1, y0, y1 = _union_box(params, phi, stroke[:, 1])
+    limits = design_limits(model)
+    bound = bounds(limits)
+    x0, x1, y0, y1 = pose_box(model, phi)
     x, y = cell_centres(x0, x1, resolution), cell_centres(y0, y1, resolution)
     xx, yy = np.meshgrid(x, y)
     q = np.column_stack([xx.ravel(), yy.ravel(), np.full(xx.size, phi)])
     zero = np.zeros_like(q)
 
-    statics = evaluate_stacked(model, "actuator_efforts", params, [q, zero, zero])
+    if model.structure.paper:
+        statics = evaluate_stacked(model, "actuator_efforts", params, [q, zero, zero])
+        lengths = leg_lengths(params, q)
+        coords = piston_displacements(params, q)
+        defined = np.isfinite(statics["conditioning"]) & (lengths > 0).all(axis=1)
+        efforts = np.stack([statics[name] for name in statics.groups["tau"]], axis=1)
+    else:  # the inverse dynamics at rest: joint coordinates, efforts, conditioning
+        statics = evaluate_stacked(model, "inverse_dynamics", params, [q, zero, zero])
+        coords = coordinates(model, params, q, limits, statics)
+        defined = np.isfinite(statics["conditioning"])  # NaN where a leg does not reach
+        efforts = np.stack([statics[f"tau_{leg}"] for leg in LEGS], axis=1)
     jacobian = evaluate_stacked(model, "actuator_jacobian", params, [q])
-    lengths = leg_lengths(params, q)
-    lambda21 = piston_displacements(params, q)
-    conditioning = np.where(np.isfinite(statics["conditioning"]) & (lengths > 0).all(axis=1),
-                            statics["conditioning"], np.nan)  # fmt: skip
-    ok = within(statics.ok(), conditioning, lambda21, stroke, min_conditioning)
+    conditioning = np.where(defined, statics["conditioning"], np.nan)
+    ok = within(statics.ok(), conditioning, coords, bound, min_conditioning)
     sign = jacobian_sign(jacobian.values)
-    efforts = np.stack([statics[name] for name in statics.groups["tau"]], axis=1)
     tau = np.where(ok[:, np.newaxis], efforts, np.nan)
 
     phi_min = np.full(q.shape[0], np.nan)
@@ -199,37 +259,24 @@ def workspace(
     inside = np.flatnonzero(ok)
     if inside.size:
         origin = (q[inside, :2], sign[inside])
-        phi_min[inside] = phi - _edge(model, params, origin, phi, -1.0, stroke, min_conditioning)
-        phi_max[inside] = phi + _edge(model, params, origin, phi, +1.0, stroke, min_conditioning)
+        phi_min[inside] = phi - _edge(model, params, origin, phi, -1.0, bound, min_conditioning)
+        phi_max[inside] = phi + _edge(model, params, origin, phi, +1.0, bound, min_conditioning)
 
     shape = xx.shape
     return WorkspaceMap(
         model=model,
         phi=phi,
         min_conditioning=float(min_conditioning),
-        stroke=tuple((float(lo), float(hi)) for lo, hi in stroke),
+        limits=tuple((leg, family, float(lo), float(hi)) for leg, family, lo, hi in limits),
         x=x,
         y=y,
         reachable=ok.reshape(shape),
         conditioning=conditioning.reshape(shape),
         jacobian_sign=sign.reshape(shape),
-        lambda21=lambda21.reshape(*shape, 3),
+        coordinates=coords.reshape(*shape, len(limits)),
         tau=tau.reshape(*shape, 3),
         phi_min=phi_min.reshape(shape),
         phi_max=phi_max.reshape(shape),
-    )
-
-
-def _union_box(params: np.ndarray, phi: float, hi: np.ndarray) -> np.ndarray:
-    """The box of the three discs together (when they share none)."""
-    boxes = [pose_extent(params, phi, np.where(np.arange(3) == k, hi[k], np.inf)) for k in range(3)]
-    return np.array(
-        [
-            min(b[0] for b in boxes),
-            max(b[1] for b in boxes),
-            min(b[2] for b in boxes),
-            max(b[3] for b in boxes),
-        ]
     )
 
 
@@ -239,7 +286,7 @@ def _edge(
     origin: tuple[np.ndarray, np.ndarray],
     phi: float,
     direction: float,
-    stroke: np.ndarray,
+    limits: np.ndarray,
     min_conditioning: float,
 ) -> np.ndarray:
     """How far (rad, in [0, pi]) the platform turns from ``phi`` in ``direction`` at each
@@ -259,7 +306,7 @@ def _edge(
 
     def reaches(rows: np.ndarray, offset: np.ndarray) -> np.ndarray:
         q = np.column_stack([xy[rows], phi + direction * offset])
-        ok, signs = reachable_signed(model, params, q, stroke, min_conditioning)
+        ok, signs = reachable_signed(model, params, q, limits, min_conditioning)
         return ok & (signs == sign[rows])
 
     for start in range(0, steps, _MARCH):

@@ -11,7 +11,9 @@ Only the NumPy backend does this (the C functions take one parameter vector).
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 
@@ -90,8 +92,15 @@ def evaluate_stacked(
     outputs = ev.allocate(info, n)
     for lo in range(0, n, BLOCK):
         block = slice(lo, min(lo + BLOCK, n))
-        p = np.ascontiguousarray(params[:, block]) if params.ndim == 2 else params
-        ev.run(info, p, [a[block] for a in arrays], [o[block] for o in outputs])
+        ins, outs = [a[block] for a in arrays], [o[block] for o in outputs]
+        if params.ndim == 1:
+            ev.run(info, params, ins, outs)
+            continue
+        p = np.ascontiguousarray(params[:, block])
+        try:
+            ev.run(info, p, ins, outs)
+        except ValueError:
+            _by_runs(ev, info, p, ins, outs)
     codes = policy.return_codes(info, arrays, outputs, applied=False)
     values = {
         name: out[:, k]
@@ -99,6 +108,22 @@ def evaluate_stacked(
         for k, name in enumerate(arg.names)
     }
     return Evaluated(values, codes, {arg.name: arg.names for arg in info.outputs})
+
+
+def _by_runs(
+    ev: Any, info: Any, params: np.ndarray, inputs: list[np.ndarray], outputs: list[np.ndarray]
+) -> None:
+    """Evaluate each run of equal parameter columns with its one parameter vector.
+
+    For generated code that is not element-wise in its parameters: a variant whose value of
+    an output depends on the parameters alone writes it with ``fill`` (the 3-PPR's ``reach``),
+    which takes a number, not a row, and raises ValueError on stacked parameters. A sweep's
+    columns come in runs (one design's samples), so this costs one call per design.
+    """
+    starts = np.flatnonzero(np.any(params[:, 1:] != params[:, :-1], axis=0)) + 1
+    edges = [0, *starts.tolist(), params.shape[1]]
+    for a, b in itertools.pairwise(edges):
+        ev.run(info, params[:, a].copy(), [x[a:b] for x in inputs], [o[a:b] for o in outputs])
 
 
 def leg_lengths(params: np.ndarray, q: np.ndarray) -> np.ndarray:

@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-from rpr3gen import manifest
+from rpr3gen import manifest, variants
 from rpr3gen.design.cluster import run_chunks
 from rpr3gen.design.grid import read_grid
 from rpr3gen.design.metrics import SweepPlan, evaluate_chunk
@@ -42,6 +42,7 @@ from rpr3gen.evaluators import all_cores
 from rpr3gen.model import ACTUATIONS, model_from_dict, read_model_data
 from rpr3gen.paths import check_output
 from rpr3gen.policy import DEFAULT_MIN_CONDITIONING
+from rpr3gen.structure import Structure
 from rpr3gen.trajectory import (
     DEFAULT_DURATION,
     DEFAULT_SAMPLES,
@@ -117,7 +118,8 @@ def sweep(
     """Evaluate every design of ``grid`` over ``trajectories``; one row per design.
 
     Args:
-        model: the base model: a model file, its data as a mapping, or None for the paper's.
+        model: the base model, of either format (any leg type): a model file, its data as a
+            mapping, or None for the paper's.
         grid: the grid file (TOML), or its content as a mapping ``{dotted key: values}``
             (:mod:`rpr3gen.design.grid`).
         trajectories: ``"rotation"``, ``"rectilinear"``, trajectory CSV files or
@@ -137,7 +139,8 @@ def sweep(
 
     Returns:
         A :class:`pyarrow.Table`: the grid's keys, then
-        :data:`rpr3gen.design.metrics.RESULT_COLUMNS`, rows in the grid's order.
+        :data:`rpr3gen.design.metrics.RESULT_COLUMNS` (a base model of the general format:
+        :data:`rpr3gen.design.metrics.GENERAL_RESULT_COLUMNS`), rows in the grid's order.
 
     Raises:
         ModelError, GridError, TrajectoryError, InputError: bad input, before any work.
@@ -276,10 +279,26 @@ def identity(plan: SweepPlan) -> str:
         "area_resolution": plan.area_resolution,
         "chunk_size": plan.chunk_size,
         "rpr3gen": __version__,
-        "generated": {a: manifest.load(a).source_hash for a in ACTUATIONS},
+        "generated": _generated(plan),
     }
     text = json.dumps(described, sort_keys=True, default=str)
     return hashlib.sha256(text.encode()).hexdigest()
+
+
+def _generated(plan: SweepPlan) -> dict[str, str]:
+    """The source hash of each generated variant the sweep may use (deriving the general
+    format's on first use)."""
+    if not plan.general:
+        return {a: manifest.load(a).source_hash for a in ACTUATIONS}
+    base = model_from_dict(plan.base, source=plan.base_source).structure
+    joints = {base.actuated}
+    if "actuated" in plan.grid.keys:
+        joints.update(plan.grid.values[plan.grid.keys.index("actuated")])
+    found = {}
+    for joint in sorted(joints):
+        structure = Structure(base.leg, joint)
+        found[structure.variant] = variants.load(structure).source_hash
+    return found
 
 
 def _open_parts(plan: SweepPlan, folder: Path, resume: bool) -> Path:
