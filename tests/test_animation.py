@@ -178,3 +178,13 @@ def test_cli_writes_the_movie(tmp_path: Path, capsys: pytest.CaptureFixture[str]
     assert "4 frames of 320 x 240" in capsys.readouterr().out
     with Image.open(out) as gif:
         assert (gif.n_frames, gif.size) == (4, (320, 240))
+
+
+@pytest.mark.skipif(not animation._ffmpeg_available(), reason="ffmpeg is not installed")
+def test_mp4_through_ffmpeg(tmp_path: Path) -> None:
+    model, traj = _robot("rrr")
+    out = tmp_path / "rrr.mp4"
+    plan = animation.write_animation(model, traj, out, fps=FPS, size=(320, 240))
+    assert plan.frames == 7
+    assert out.read_bytes()[4:8] == b"ftyp"  # an MP4 container
+    assert [p.name for p in tmp_path.iterdir()] == ["rrr.mp4"]
