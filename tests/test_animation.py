@@ -46,6 +46,8 @@ def test_plan_places_frames_in_time() -> None:
     np.testing.assert_array_equal(fast.samples, np.arange(0, 301, 20))
     coarse = animation.plan(np.array([0.0, 1.0, 2.0]), "m.gif", fps=2)
     np.testing.assert_array_equal(coarse.samples, [0, 0, 1, 1, 2])  # nearest, ties to earlier
+    single = animation.plan(np.array([0.5]), "m.gif")
+    np.testing.assert_array_equal(single.samples, [0])  # one pose: one frame
 
 
 @pytest.mark.parametrize(

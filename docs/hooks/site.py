@@ -5,7 +5,8 @@ source:
 
 - ``<!-- include FILE#HEADING -->`` in a page is replaced by that section of FILE (a path from
   the repository's root; the section runs to the next heading of its level or above): the
-  README's Quick start, the interface's model formats ...
+  README's Quick start, its model file ...; ``include-intro`` stops at the section's first
+  subheading.
 - ``commands.md`` is generated from the command line's own ``--help`` (argparse), one section
   per command.
 - ``<!-- file PATH -->`` becomes the whole file as a code block (a gallery model ...).
@@ -25,6 +26,7 @@ import contextlib
 import inspect
 import io
 import logging
+import os
 import posixpath
 import re
 from pathlib import Path
@@ -38,7 +40,7 @@ log = logging.getLogger("mkdocs.plugins.rpr3gen")
 
 ROOT = Path(__file__).resolve().parents[2]
 DOCS = ROOT / "docs"
-INCLUDE = re.compile(r"<!--\s*include\s+(\S+?)#(.+?)\s*-->")
+INCLUDE = re.compile(r"<!--\s*include(-intro)?\s+(\S+?)#(.+?)\s*-->")
 HEADER = re.compile(r"<!--\s*header-excerpt\s+(\S+)\s*-->")
 WHOLE = re.compile(r"<!--\s*file\s+(\S+)\s*-->")
 LINK = re.compile(r"(!?)\[([^\]]*)\]\(([^)\s]+)\)")
@@ -75,7 +77,8 @@ def on_config(config: Any) -> Any:
     SHOWN.clear()
     for page in sorted(DOCS.glob("*.md")):
         for m in INCLUDE.finditer(page.read_text(encoding="utf-8")):
-            SHOWN.setdefault((m[1], m[2].strip()), page.name)
+            if not m[1]:  # an intro shows no subsection
+                SHOWN.setdefault((m[2], m[3].strip()), page.name)
     nav = config["nav"]
     notebooks = [{_title(p): f"notebooks/{p.name}"} for p in _notebooks()]
     reports = [{_title(p): f"benchmarks/{p.name}"} for p in _benchmark_reports()]
@@ -110,15 +113,16 @@ def on_page_markdown(markdown: str, page: Any, config: Any, files: Files) -> str
     source = Path(page.file.abs_src_path) if page.file.abs_src_path else DOCS / page_uri
 
     def include(m: re.Match[str]) -> str:
-        path = ROOT / m[1]
+        intro, name, heading = bool(m[1]), m[2], m[3]
+        path = ROOT / name
         if not path.is_file():
-            log.warning(f"{page_uri}: include: no file {m[1]}")
+            log.warning(f"{page_uri}: include: no file {name}")
             return ""
-        section = _section(path.read_text(encoding="utf-8"), m[2])
+        section = _section(path.read_text(encoding="utf-8"), heading, intro=intro)
         if section is None:
-            log.warning(f"{page_uri}: include: no heading {m[2]!r} in {m[1]}")
+            log.warning(f"{page_uri}: include: no heading {heading!r} in {name}")
             return ""
-        return _rewrite_links(section, path, page_uri, anchors=_anchors(m[1], page_uri))
+        return _rewrite_links(section, path, page_uri, anchors=_anchors(name, page_uri))
 
     markdown = INCLUDE.sub(include, markdown)
     markdown = HEADER.sub(lambda m: _header_excerpt(m[1], page_uri), markdown)
@@ -153,8 +157,9 @@ def on_pre_build(config: Any) -> None:
                         log.warning(f"{module.__name__}.{name}.{attr}: no docstring")
 
 
-def _section(text: str, heading: str) -> str | None:
-    """The body of the section under ``heading`` (its text, without the heading's hashes)."""
+def _section(text: str, heading: str, intro: bool = False) -> str | None:
+    """The body of the section under ``heading`` (its text, without the heading's hashes); with
+    ``intro``, only what comes before its first subheading."""
     lines = text.splitlines()
     fenced = False
     start = level = None
@@ -167,7 +172,7 @@ def _section(text: str, heading: str) -> str | None:
         if start is None:
             if m[2] == heading.strip():
                 start, level = k + 1, len(m[1])
-        elif len(m[1]) <= level:  # type: ignore[operator]
+        elif intro or len(m[1]) <= level:  # type: ignore[operator]
             return "\n".join(lines[start:k]).strip("\n") + "\n"
     if start is None:
         return None
@@ -272,9 +277,18 @@ def _commands_page() -> str:
 
 
 def _help(parser: Any) -> str:
+    """``parser``'s help, wrapped at 100 columns whatever the terminal (argparse reads COLUMNS)."""
     out = io.StringIO()
-    with contextlib.redirect_stdout(out):
-        parser.print_help()
+    columns = os.environ.get("COLUMNS")
+    os.environ["COLUMNS"] = "100"
+    try:
+        with contextlib.redirect_stdout(out):
+            parser.print_help()
+    finally:
+        if columns is None:
+            del os.environ["COLUMNS"]
+        else:
+            os.environ["COLUMNS"] = columns
     return out.getvalue()
 
 

@@ -210,10 +210,12 @@ def plan(
             f"{MAX_GIF_PIXELS:.3g} pixels in all: make it smaller, lower fps or write an .mp4"
         )
     times = t[0] + np.arange(count) * (speed / fps)
-    after = np.clip(np.searchsorted(t, times), 1, max(t.size - 1, 1))
-    before = after - 1
-    nearest = np.where(np.abs(t[after] - times) < np.abs(times - t[before]), after, before)
-    samples = np.minimum(nearest, t.size - 1) if t.size > 1 else np.zeros(count, dtype=np.intp)
+    if t.size == 1:
+        samples = np.zeros(count, dtype=np.intp)
+    else:  # the nearer of the samples around each time, the earlier on a tie
+        after = np.clip(np.searchsorted(t, times), 1, t.size - 1)
+        before = after - 1
+        samples = np.where(np.abs(t[after] - times) < np.abs(times - t[before]), after, before)
     return Plan(path, writer, fps, float(speed), (width, height), samples)
 
 
