@@ -623,7 +623,7 @@ def write_animation(
         min_conditioning: Refuse poses whose ``conditioning`` is below this.
 
     Returns:
-        The :class:`Plan` written (path, frames, size).
+        The plan that was written (its path, frames and size).
 
     Raises:
         InputError: For a request out of bounds (see :func:`plan`).
