@@ -20,7 +20,7 @@ def _quick_start(root: Path) -> list[str]:
 def test_quick_start_is_one_environment_for_the_main_job_and_the_tests(repo_root: Path) -> None:
     setup_and_run, test = _quick_start(repo_root)
     assert setup_and_run.startswith(
-        "python3 -m venv .venv && .venv/bin/pip install -q -e '.[dev,peers]'"
+        "python3 -m venv .venv && .venv/bin/pip install -q -e '.[dev,peers,docs]'"
     )
     assert setup_and_run.endswith(" && .venv/bin/rpr3gen paper --out docs/paper")
     assert test == ".venv/bin/python -m pytest"  # the same .venv, not built a second time

@@ -2,8 +2,9 @@
 
 Every joint of a leg allows, or when released would allow, three relative motions of its later
 body: two translations and a rotation about the joint's point ``X_j``. A revolute joint's
-translations are taken along the world axes x0, y0 (its loads ``fx``, ``fy``); a prismatic
-joint's along its current axis ``w`` and across it, ``perp(w)`` (loads ``f_axis``, ``f_normal``).
+translations are taken along the leg frame ``(e, perp(e))`` and its loads turned to the world
+axes x0, y0 on output (``fx``, ``fy``); a prismatic joint's along its current axis ``w`` and
+across it, ``perp(w)`` (loads ``f_axis``, ``f_normal``).
 The load of each motion is the component of the chain wrench ``(F_j, M_j)`` of eqs. (10)-(11)
 that does work on it.
 

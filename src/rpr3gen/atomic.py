@@ -18,7 +18,7 @@ import numpy as np
 
 from rpr3gen.errors import InputError
 
-__all__ = ["atomic_write", "write_csv_table", "write_results_csv"]
+__all__ = ["atomic_path", "atomic_write", "write_csv_table", "write_results_csv"]
 
 _WRITE_MODES = frozenset({"w", "wt", "wb", "tw", "bw"})
 
@@ -66,6 +66,41 @@ def atomic_write(path: str | os.PathLike[str], mode: str = "w", **kw: Any) -> It
             yield f
             f.flush()
             os.fsync(f.fileno())
+        os.chmod(tmp, _mode_for(target))
+        os.replace(tmp, target)
+    except BaseException as exc:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+        if isinstance(exc, OSError) and exc.filename in (None, tmp):
+            raise _about(exc, path) from exc
+        raise
+    _fsync_folder(folder)
+
+
+@contextlib.contextmanager
+def atomic_path(path: str | os.PathLike[str]) -> Iterator[str]:
+    """A temporary file's path that replaces ``path`` when the block succeeds.
+
+    For writers that want a file name rather than an open file (a movie encoder run as a
+    subprocess, an image library that picks the format from the suffix): the temporary file
+    lives in the target's folder and keeps the target's suffix. On success it gets the
+    permission bits :func:`atomic_write` gives and is renamed over ``path``; on any failure,
+    including a ``KeyboardInterrupt``, it is removed and an existing target is untouched.
+
+    Raises:
+        OSError: If the temporary file cannot be created or renamed; its ``filename`` is
+            ``path`` as given.
+    """
+    target = os.path.abspath(os.fspath(path))
+    folder, name = os.path.split(target)
+    suffix = os.path.splitext(name)[1]
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{name}.", suffix=f".tmp{suffix}", dir=folder)
+        os.close(fd)
+    except OSError as exc:
+        raise _about(exc, path) from exc
+    try:
+        yield tmp
         os.chmod(tmp, _mode_for(target))
         os.replace(tmp, target)
     except BaseException as exc:

@@ -22,7 +22,7 @@ from typing import TextIO
 
 import numpy as np
 
-from rpr3gen import __version__, cli_identification, sizes, variants
+from rpr3gen import __version__, animation, cli_identification, sizes, variants
 from rpr3gen.backends import BACKENDS, inverse_dynamics, output_names
 from rpr3gen.cli_args import EXIT_ERROR, Parser, as_option, integer, number, subparser
 from rpr3gen.derivatives import MAX_SMOOTHING
@@ -183,6 +183,7 @@ def _parser() -> argparse.ArgumentParser:
     fk.add_argument("qa", nargs=3, type=number(), metavar="QA", help="actuator coordinate")
 
     cli_identification.add_parsers(sub, paper_model)
+    _animate_parser(sub, paper_model)
     ws = sub.add_parser(
         "workspace",
         help="workspace and singularity maps of a design at a fixed platform angle",
@@ -580,6 +581,70 @@ def _cmd_fk(args: argparse.Namespace) -> int:
     return 0
 
 
+def _animate_parser(sub: argparse._SubParsersAction, paper_model: str) -> None:
+    anim = sub.add_parser(
+        "animate",
+        help="draw the robot moving along a trajectory, with its actuator efforts (GIF or MP4)",
+        description="Draw the base, the legs and the platform along the motion, the actuator "
+        "efforts as bars and as curves with a time cursor (and with --loads every joint's "
+        "force as an arrow); GIF through Pillow, MP4 through ffmpeg when installed. Frames are "
+        f"bounded: at most {animation.MAX_FRAMES}, sides {animation.MIN_SIDE} to "
+        f"{animation.MAX_SIDE} pixels.",
+    )
+    anim.add_argument("--model", metavar="FILE", help=f"model TOML file ({paper_model})")
+    anim.add_argument(
+        "--trajectory",
+        default="rotation",
+        metavar="NAME|FILE.csv",
+        help="'rotation', 'rectilinear' or a trajectory CSV file (default: rotation)",
+    )
+    anim.add_argument(
+        "--duration",
+        type=number(least=DURATIONS[0], most=DURATIONS[1], unit="s"),
+        metavar="T",
+        help=f"duration of a paper trajectory, s (default: {DEFAULT_DURATION:g})",
+    )
+    anim.add_argument("--out", required=True, metavar="FILE.gif|FILE.mp4", help="the movie")
+    anim.add_argument(
+        "--fps",
+        type=integer(1, animation.MAX_FPS),
+        default=animation.DEFAULT_FPS,
+        metavar="N",
+        help=f"frames per second, 1 to {animation.MAX_FPS} (default: {animation.DEFAULT_FPS})",
+    )
+    anim.add_argument(
+        "--speed",
+        type=number(greater=0),
+        default=1.0,
+        metavar="S",
+        help="trajectory seconds per movie second (default: 1, real time)",
+    )
+    anim.add_argument(
+        "--size",
+        default="{}x{}".format(*animation.DEFAULT_SIZE),
+        metavar="WxH",
+        help="frame size in pixels (default: {}x{})".format(*animation.DEFAULT_SIZE),
+    )
+    anim.add_argument("--loads", action="store_true", help="draw every joint's force as an arrow")
+    anim.add_argument(
+        "--backend", choices=BACKENDS, default="numpy", help="generated code (default: numpy)"
+    )
+    anim.set_defaults(samples=None, smoothing=None)
+
+
+def _cmd_animate(args: argparse.Namespace) -> int:
+    size = animation.parse_size(args.size)
+    name, traj = _trajectory(args)
+    animation.plan(traj.t, args.out, fps=args.fps, speed=args.speed, size=size)  # before work
+    model = load_model(args.model)
+    done = animation.write_animation(
+        model, traj, args.out, fps=args.fps, speed=args.speed, size=size, loads=args.loads,
+        title=f"{model.name}: {model.structure.title}, {name}", backend=args.backend,
+    )  # fmt: skip
+    print(f"wrote {done.path}: {done.frames} frames of {size[0]} x {size[1]} at {args.fps}/s")
+    return 0
+
+
 def _cmd_workspace(args: argparse.Namespace) -> int:
     from rpr3gen.design import workspace, write_workspace
 
@@ -733,6 +798,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         "paper": _cmd_paper,
         "params": _cmd_params,
         "fk": _cmd_fk,
+        "animate": _cmd_animate,
         "workspace": _cmd_workspace,
         "sweep": _cmd_sweep,
         "generate": _cmd_generate,

@@ -505,8 +505,10 @@ def identify(
 
     Args:
         model: the robot whose geometry (and payload) the regressor uses; its masses are not.
-        q, qd, qdd: (n, 3) the measured platform motion (velocities and accelerations as
-            estimated, e.g. by a smoothing spline: :meth:`rpr3gen.Trajectory.from_positions`).
+        q: (n, 3) the measured platform poses.
+        qd: (n, 3) their velocities, as estimated (e.g. by a smoothing spline:
+            :meth:`rpr3gen.Trajectory.from_positions`).
+        qdd: (n, 3) their accelerations, estimated likewise.
         tau: (n, 3) the measured actuator efforts (``m10_*`` or ``f21z_*``).
         friction: also estimate viscous and Coulomb friction per actuator.
         identical_legs: the legs share one set of parameters (B = 9 instead of 19).

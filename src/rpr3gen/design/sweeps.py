@@ -134,7 +134,8 @@ def sweep(
         chunk_size: designs per task.
         min_conditioning: the least conditioning of a feasible pose, in [0, 1).
         area_resolution: grid points per axis of the workspace area (0: no area).
-        samples, duration: of the paper trajectories.
+        samples: samples of each paper trajectory.
+        duration: duration of each paper trajectory, s.
         progress: show a progress bar on stderr when it is a terminal.
 
     Returns:
