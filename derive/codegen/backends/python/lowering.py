@@ -129,7 +129,7 @@ class _Lowering:
         if self.is_scalar(expr):
             text = self.scalar(expr)
             if dest:
-                self.lines.append(f"{dest}.fill({text})")
+                self.lines.append(f"numpy.copyto({dest}, {text})")
                 return dest
             return text
         if expr.is_Symbol:
