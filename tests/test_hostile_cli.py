@@ -139,6 +139,17 @@ COMMANDS: tuple[Command, ...] = (
     ),
     Command("params", lambda tmp: ["params"], inputs={"--model": "model"}),
     Command(
+        "animate",
+        lambda tmp: ["animate", "--out", str(tmp / "a.gif"), "--fps", "1", "--size", "240x240"],
+        numbers={
+            "--duration": DURATION,
+            "--fps": Numeric(whole=True, least=1, most=60),
+            "--speed": Numeric(least=0.0),
+        },
+        outputs={"--out": False},
+        inputs={"--model": "model", "--trajectory": "trajectory"},
+    ),
+    Command(
         "fk",
         lambda tmp: ["fk", "0.1", "0.0", "0.0"],
         numbers={"QA": Numeric()},
@@ -346,13 +357,15 @@ def test_an_output_that_cannot_be_written_is_refused_before_any_work(
 def test_a_failing_run_leaves_an_existing_output_byte_identical(
     command: Command, option: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    target = tmp_path / "existing"
+    argv = command.argv(tmp_path)
+    given = argv[argv.index(option) + 1] if option in argv else ""
+    target = tmp_path / f"existing{Path(given).suffix}"  # the kind of file the option writes
     if command.outputs[option]:
         target.mkdir()
         (target / "earlier.txt").write_bytes(b"earlier results\n")
     else:
         target.write_bytes(b"earlier results\n")
-    argv = with_option(command.argv(tmp_path), option, str(target))
+    argv = with_option(argv, option, str(target))
     before = snapshot(tmp_path)
     refused([*argv, *command.failing], capsys, command.failing[-1])
     assert snapshot(tmp_path) == before

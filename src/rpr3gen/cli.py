@@ -633,6 +633,7 @@ def _animate_parser(sub: argparse._SubParsersAction, paper_model: str) -> None:
 
 
 def _cmd_animate(args: argparse.Namespace) -> int:
+    check_output(args.out, "the movie", argument="out")
     size = animation.parse_size(args.size)
     name, traj = _trajectory(args)
     animation.plan(traj.t, args.out, fps=args.fps, speed=args.speed, size=size)  # before work
