@@ -22,6 +22,21 @@ class NumpyPrinter(NumPyPrinter):
         x = self._print(expr.args[0])
         return f"(({x}) - {TWO_PI}*numpy.rint(({x})*{INV_TWO_PI}))"
 
+    def _fold(self, ufunc: str, expr: sp.Expr) -> str:
+        # Nested two-argument ufuncs, as the vector path (lowering) and the C printer fold
+        # them; SymPy's own n-ary form needs functools, which generated modules do not import.
+        args = [self._print(a) for a in expr.args]
+        text = args[-1]
+        for arg in reversed(args[:-1]):
+            text = f"numpy.{ufunc}({arg}, {text})"
+        return text
+
+    def _print_Min(self, expr: sp.Expr) -> str:
+        return self._fold("fmin", expr)
+
+    def _print_Max(self, expr: sp.Expr) -> str:
+        return self._fold("fmax", expr)
+
 
 _PRINTER = NumpyPrinter()  # stateless between calls; built once, it is most of a call's cost
 
