@@ -285,10 +285,16 @@ def lower_numpy(
 ) -> LoweredNumpy:
     """Lower ``code`` given where inputs live (``{x: "x"}``) and each output's row text."""
     statements, outputs = fold_copies(code, params)
-    # Output rows: an output that is a named intermediate is computed in place.
+    # Values of parameters only: Python scalars, computed before the vector lines.
+    scalar = set(params)
+    for lhs, rhs in statements:
+        if rhs.free_symbols <= scalar:
+            scalar.add(lhs)
+    # Output rows: an output that is a named per-sample intermediate is computed in place (a
+    # scalar one, or a parameter, is never written into a row: it is filled at the end).
     alias: dict[sp.Symbol, str] = {}
     for name, expr in outputs:
-        if expr.is_Symbol and expr not in alias and expr not in inputs:
+        if expr.is_Symbol and expr not in alias and expr not in inputs and expr not in scalar:
             alias[expr] = output_rows[name]
     uses: dict[sp.Symbol, int] = {}  # index of each symbol's last use
     for index, (_, rhs) in enumerate(statements):
