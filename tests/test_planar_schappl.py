@@ -15,7 +15,7 @@ centres of mass in the links' frames (x from a joint to the next).
 Compared: SchapplM's ``Jinv`` with rpr3gen's ``actuator_jacobian``; its ``tauX`` with
 ``M qdd + c`` of ``task_space_dynamics``; and the actuator torques ``Jinv^-T tauX``, SchapplM's
 alone, with rpr3gen's ``inverse_dynamics`` ``tau_A..C``. Measured: J within 9e-16, ``tauX``
-3.4e-16 and the torques 1.1e-15 of their largest values (torques up to 14 N m); gravity reversed,
+3.3e-16 and the torques 1.2e-15 of their largest values (torques up to 13 N m); gravity reversed,
 a centre of mass moved 2 cm or an inertia 10 % off in SchapplM's parameters shows as 2, 5e-2
 and 2e-4. The model has no payload: rpr3gen's is zero here.
 """
@@ -66,9 +66,8 @@ def _congruent_robot(rng: np.random.Generator) -> dict:
     for k, leg in enumerate(LEGS):
         base_angle = math.radians(-90 + 120 * k + rng.uniform(-20, 20))
         p1 = rng.uniform(0.45, 0.55) * np.array([math.cos(base_angle), math.sin(base_angle)])
-        p3 = rng.uniform(0.12, 0.2) * np.array(
-            [math.cos(base_angle + rng.uniform(-0.4, 0.4)), math.sin(base_angle)]
-        )
+        platform_angle = base_angle + rng.uniform(-0.4, 0.4)
+        p3 = rng.uniform(0.12, 0.2) * np.array([math.cos(platform_angle), math.sin(platform_angle)])
         d = np.linalg.norm(p3 - p1)
         assert abs(a1 - a2) < d < a1 + a2
         # The elbow: |p2 - p1| = a1, |p3 - p2| = a2, on either side of p1 -> p3.
