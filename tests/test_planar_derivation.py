@@ -10,14 +10,14 @@ Jacobian by finite differences and its rate term, the mass matrix against the ki
 the actuator rates, the direct kinematics' candidates, and the identification regressor.
 
 Each structure is derived once per process (``functools.cache``): the inverse dynamics and the
-control model of all 18 in about 9 s of CPU; the direct kinematics and the regressor, which cost
-as much again, on 7 structures that cover every leg type, every kind of locked-leg hold (circle,
-line, platform line) with both kinds of actuated joint (``DK_STRUCTURES``), and every leg type
-with both kinds of actuated joint (``REGRESSOR_STRUCTURES``). Measured worst relative errors
-over the structures (seeds below): inverse dynamics 5.3e-15, balances 1.9e-15, power 3.5e-15, J
-against central differences 2.3e-10 (truncation and round-off of the differences), actuator
-rates and accelerations 1.1e-15, mass matrix 8.7e-16, ``M qdd + c - J^T tau`` 2.5e-15, forward
-dynamics 1.7e-13, direct kinematics 6.4e-15 (of the platform radius), regressor 4.0e-15.
+control model of all 18 in about 8 s of CPU; the direct kinematics and the regressor, about 7 s
+more, on 7 structures that cover every leg type, every kind of locked-leg hold (circle, line,
+platform line) with both kinds of actuated joint (``DK_STRUCTURES``), and every leg type with both
+kinds of actuated joint (``REGRESSOR_STRUCTURES``). Measured worst relative errors over the
+structures (seeds below): inverse dynamics 5.2e-15, balances 2.3e-15, power 2.9e-15, J against
+central differences 2.3e-10 (truncation and round-off of the differences), actuator rates and
+accelerations 1.1e-15, mass matrix 6.4e-16, ``M qdd + c - J^T tau`` 1.5e-15, forward dynamics
+1.7e-13, direct kinematics 1.4e-14 (of the platform radius), regressor 4.5e-15.
 """
 
 from __future__ import annotations
