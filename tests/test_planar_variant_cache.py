@@ -142,3 +142,30 @@ def test_a_variant_of_another_generator_is_not_reused(
     assert variants.ensure(structure) == current  # and from the cache now
     assert calls == [current]
     assert (stale / structure.variant / "manifest.json").is_file()  # left alone
+
+
+def test_a_derivation_that_finds_its_variant_already_there_keeps_it(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Where the lock does not hold (no ``fcntl``, a file system without ``flock``), two
+    processes may both derive a new variant: the second to finish finds the first's complete
+    folder in place and keeps it, rather than failing on the rename. Here the two derivations
+    run one after the other, each writing the committed ``rrr_1``'s files (a stand-in for
+    SymPy)."""
+    from rpr3gen_derive.planar import generate
+
+    monkeypatch.setenv("RPR3GEN_CACHE_DIR", str(tmp_path))
+    structure = Structure("RRR", 1)
+    committed = manifest.default_folder()
+    files = {
+        path.relative_to(committed).as_posix(): path.read_text()
+        for path in [committed / "__init__.py", *(committed / structure.variant).iterdir()]
+        if path.is_file() and path.suffix in (".py", ".c", ".h", ".json")
+    }
+    monkeypatch.setattr(generate, "render", lambda *args, **kwargs: files)
+    root = variants.folder(structure)
+    variants._derive(structure, root)
+    first = manifest.load(structure.variant, root)
+    variants._derive(structure, root)  # the other process, finishing second
+    assert manifest.load(structure.variant, root) == first
+    assert sorted(p.name for p in root.iterdir()) == ["__init__.py", structure.variant]
