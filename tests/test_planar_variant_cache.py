@@ -7,9 +7,12 @@
   and its files carry the generator's hash, which keys the folder.
 - A variant of another generator (a folder under another hash's key) is never reused: the
   current generator derives its own, next to it.
+- Where the lock does not hold, a second derivation that finds the variant already in place
+  keeps it instead of failing.
 
 No sleeps and no timing: the order of events is fixed by the lock and by the processes' output.
-The variant is ``ppr_2``, the quickest to derive (about 3 s of CPU).
+One real derivation, of ``ppr_2``, the quickest (about 3 s of CPU); the other tests stand in
+for SymPy with the committed ``rrr_1``'s files.
 """
 
 from __future__ import annotations
