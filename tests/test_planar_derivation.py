@@ -171,8 +171,7 @@ def _bound(check: str, kinds: str, actuated: int, err: float, tol: float, at: st
     assert err < tol, f"{check}: {err:.2e} (bound {tol:.0e}) {at}"
 
 
-@pytest.mark.parametrize(("kinds", "actuated"), STRUCTURES, ids=IDS)
-def test_inverse_dynamics_matches_the_reference(kinds: str, actuated: int) -> None:
+def _inverse_dynamics_matches_the_reference(kinds: str, actuated: int) -> None:
     """Every output (joint coordinates modulo 2 pi, rates, accelerations, every joint load,
     efforts) on two random models, each along a random motion, relative to the largest value
     of its unit; reach 1 at home and positive along the motion; conditioning in (0, 1]."""
@@ -187,8 +186,7 @@ def test_inverse_dynamics_matches_the_reference(kinds: str, actuated: int) -> No
         assert np.all((s.out["conditioning"] > 0) & (s.out["conditioning"] <= 1 + 1e-12))
 
 
-@pytest.mark.parametrize(("kinds", "actuated"), STRUCTURES, ids=IDS)
-def test_power_balance(kinds: str, actuated: int) -> None:
+def _power_balance(kinds: str, actuated: int) -> None:
     """The actuators' and the payload's power equals the rate of the robot's energy (the
     reference's analytic dE/dt), with the derivation's efforts and joint rates."""
     s = _solved(kinds, actuated)
@@ -197,8 +195,7 @@ def test_power_balance(kinds: str, actuated: int) -> None:
     _bound("power", kinds, actuated, _rel(supplied, stored), 1e-11)
 
 
-@pytest.mark.parametrize(("kinds", "actuated"), STRUCTURES, ids=IDS)
-def test_balance_at_rest_and_of_the_platform(kinds: str, actuated: int) -> None:
+def _balance_at_rest_and_of_the_platform(kinds: str, actuated: int) -> None:
     """At rest (poses of the motion), the base's loads on the legs balance the weight of every
     body and the payload (forces and moments about the origin, bodies placed by the
     derivation's own joint coordinates); in motion, the joint-3 loads, gravity and the payload
@@ -215,8 +212,7 @@ def test_balance_at_rest_and_of_the_platform(kinds: str, actuated: int) -> None:
         assert np.max(np.abs(chk.wrap(pose[:, 2] - s.q[:, 2]))) < 1e-13
 
 
-@pytest.mark.parametrize(("kinds", "actuated"), STRUCTURES, ids=IDS)
-def test_actuator_jacobian_and_its_rate(kinds: str, actuated: int) -> None:
+def _actuator_jacobian_and_its_rate(kinds: str, actuated: int) -> None:
     """J against central differences of the actuator coordinates; ``J qd`` the actuator rates,
     ``J qdd + J' qd`` their accelerations; the platform velocity from the rates is qd."""
     s = _solved(kinds, actuated)
@@ -240,8 +236,7 @@ def test_actuator_jacobian_and_its_rate(kinds: str, actuated: int) -> None:
     _bound("J rates", kinds, actuated, _rel(pv, s.qd), 1e-12)
 
 
-@pytest.mark.parametrize(("kinds", "actuated"), STRUCTURES, ids=IDS)
-def test_task_space_dynamics(kinds: str, actuated: int) -> None:
+def _task_space_dynamics(kinds: str, actuated: int) -> None:
     """M symmetric positive definite and equal to the kinetic energy's mass matrix (the
     reference's, independent of any Newton-Euler solve); ``M qdd + c = J^T tau``."""
     s = _solved(kinds, actuated)
@@ -254,8 +249,7 @@ def test_task_space_dynamics(kinds: str, actuated: int) -> None:
     _bound("M qdd + c = J^T tau", kinds, actuated, _rel(lhs, rhs), 1e-12)
 
 
-@pytest.mark.parametrize(("kinds", "actuated"), STRUCTURES, ids=IDS)
-def test_forward_dynamics_inverts_inverse_dynamics(kinds: str, actuated: int) -> None:
+def _forward_dynamics_inverts_inverse_dynamics(kinds: str, actuated: int) -> None:
     """``fd(q, qd, tau(q, qd, qdd)) = qdd``; with random efforts, the reference's."""
     s = _solved(kinds, actuated)
     f = _control(kinds, actuated)
@@ -265,6 +259,32 @@ def test_forward_dynamics_inverts_inverse_dynamics(kinds: str, actuated: int) ->
     ours = f(s.model, q=s.q, qd=s.qd, tau=tau)["fd"]
     ref = pr.forward_dynamics(s.robot, s.q, s.qd, tau)
     _bound("forward dynamics", kinds, actuated, _rel(ours, ref), 1e-11)
+
+
+#: The checks of the inverse dynamics and the control model, run by one test per structure.
+CHECKS = (
+    _inverse_dynamics_matches_the_reference,
+    _power_balance,
+    _balance_at_rest_and_of_the_platform,
+    _actuator_jacobian_and_its_rate,
+    _task_space_dynamics,
+    _forward_dynamics_inverts_inverse_dynamics,
+)
+
+
+@pytest.mark.parametrize(("kinds", "actuated"), STRUCTURES, ids=IDS)
+def test_inverse_dynamics_and_control_model(kinds: str, actuated: int) -> None:
+    """Every check of ``CHECKS`` on the structure. One test per structure, so that each is
+    derived once per session on pytest-xdist workers too (separate tests of one structure
+    would land on several workers, each deriving it); every check runs, and the failures are
+    reported together."""
+    failures = []
+    for check in CHECKS:
+        try:
+            check(kinds, actuated)
+        except AssertionError as exc:
+            failures.append(f"{check.__name__[1:]}: {exc}")
+    assert not failures, "\n".join(failures)
 
 
 # -- direct kinematics -----------------------------------------------------------------------
@@ -332,19 +352,19 @@ def test_the_direct_kinematics_sample_covers_every_hold() -> None:
     ("kinds", "actuated"), DK_STRUCTURES, ids=[f"{k}{a}" for k, a in DK_STRUCTURES]
 )
 def test_direct_kinematics_candidates_contain_the_true_pose(kinds: str, actuated: int) -> None:
-    """For poses of the motion, the actuator coordinates (from the derivation's own inverse
-    kinematics) give at most the bound of candidates (6 on circles, 2 on lines), and the pose
-    is one of them."""
-    s = _solved(kinds, actuated)
+    """For poses of the motion, the actuator coordinates (the reference's inverse kinematics)
+    give at most the bound of candidates (6 on circles, 2 on lines), and the pose is one of
+    them."""
+    model, robot, q, _, _ = _case(kinds, actuated)
     kind, candidates = _direct_kinematics(kinds, actuated)
-    rho = s.robot.platform_radius
+    rho = robot.platform_radius
+    qa = np.stack([x[:, actuated - 1] for x in pr.inverse_kinematics(robot, q)], axis=1)
     for i in (0, 3, 6):
-        qa = _actuated(s.out, "q", actuated)[i]
-        found = candidates(s.model, qa)
+        found = candidates(model, qa[i])
         assert 1 <= len(found) <= direct_kinematics.MAX_MODES[kind]
         d = np.hypot(
-            np.hypot(found[:, 0] - s.q[i, 0], found[:, 1] - s.q[i, 1]),
-            rho * chk.wrap(found[:, 2] - s.q[i, 2]),
+            np.hypot(found[:, 0] - q[i, 0], found[:, 1] - q[i, 1]),
+            rho * chk.wrap(found[:, 2] - q[i, 2]),
         )
         _bound("direct kinematics", kinds, actuated, float(np.min(d)) / rho, 1e-10)
 
@@ -387,15 +407,16 @@ REGRESSOR_STRUCTURES = [
 def test_regressor_reproduces_the_efforts(kinds: str, actuated: int) -> None:
     """``Y pi + tau_payload`` equals the reference's efforts, pi from the model's bodies (mass,
     first moment and inertia about the body's first joint point, world axes at home)."""
-    s = _solved(kinds, actuated)
+    model, robot, q, qd, qdd = _case(kinds, actuated)
     names, evaluate = _regressor(kinds, actuated)
-    values = chk.inertial_values(s.model)
+    values = chk.inertial_values(model)
     assert set(values) == set(names)
     pi = np.array([values[n] for n in names])
-    Y, tau0 = evaluate(s.model, s.q, s.qd, s.qdd)
-    _bound("regressor", kinds, actuated, _rel(Y @ pi + tau0, pr.efforts(s.ref)), 1e-11)
+    Y, tau0 = evaluate(model, q, qd, qdd)
+    expected = pr.efforts(pr.solve(robot, q, qd, qdd))
+    _bound("regressor", kinds, actuated, _rel(Y @ pi + tau0, expected), 1e-11)
     # tau_payload holds the payload alone: the efforts at rest without gravity.
-    zero = np.zeros_like(s.q)
-    weightless = pr.parse_model({**s.model, "environment": {"gravity": [0.0, 0.0]}})
-    at_rest = pr.efforts(pr.solve(weightless, s.q, zero, zero))
+    zero = np.zeros_like(q)
+    weightless = pr.parse_model({**model, "environment": {"gravity": [0.0, 0.0]}})
+    at_rest = pr.efforts(pr.solve(weightless, q, zero, zero))
     _bound("regressor", kinds, actuated, _rel(tau0, at_rest), 1e-11)
