@@ -63,6 +63,7 @@ def _case() -> tuple[dict, np.ndarray]:
     return data, q
 
 
+@pytest.mark.slow
 def test_two_processes_derive_a_new_variant_once(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capfd: pytest.CaptureFixture[str]
 ) -> None:
