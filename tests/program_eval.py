@@ -45,7 +45,9 @@ def compile_program(
 
     Outputs are broadcast against each other, so constant outputs come back as arrays too.
     """
-    printer = _Printer({"fully_qualified_modules": False, "inline": True})
+    # order="none": terms printed as SymPy holds them, not sorted (the sort is most of the
+    # printing time of long sums; only the order of floating-point additions changes).
+    printer = _Printer({"fully_qualified_modules": False, "inline": True, "order": "none"})
     names = [s.name for s in inputs]
     lines = [f"def _program({', '.join(names)}):"]
     for symbol, expr in _live(prog, outputs):

@@ -95,7 +95,13 @@ def _derive(structure: Structure, root: Path) -> None:
     staging = Path(tempfile.mkdtemp(prefix=".staging-", dir=root))
     try:
         write_files(staging, files)
-        os.replace(staging / structure.variant, root / structure.variant)
+        try:
+            os.replace(staging / structure.variant, root / structure.variant)
+        except OSError:
+            # Where the lock does not hold, another process may have put the same variant in
+            # place first (a directory is not replaced by a rename): keep it.
+            if not (root / structure.variant / "manifest.json").is_file():
+                raise
         if not (root / "__init__.py").exists():
             os.replace(staging / "__init__.py", root / "__init__.py")
     finally:
