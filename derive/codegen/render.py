@@ -10,28 +10,21 @@ Stages can be timed: pass ``stage``, a callable that returns a context manager f
 
 from __future__ import annotations
 
-import contextlib
 import json
-from collections.abc import Callable, Iterable, Sequence
-from contextlib import AbstractContextManager
-from dataclasses import dataclass
+from collections.abc import Iterable, Sequence
 from pathlib import Path
 from typing import Any
 
 import jinja2
-import sympy as sp
-from rpr3gen_derive.codegen.cse import StraightLine, straight_line
+from rpr3gen_derive.codegen.backends import c, python
+from rpr3gen_derive.codegen.backends.c import comment
+from rpr3gen_derive.codegen.compiled import Stage, compile_function, no_stage
 from rpr3gen_derive.codegen.files import source_hash
-from rpr3gen_derive.codegen.spec import Argument, FunctionSpec, ModuleSpec
+from rpr3gen_derive.codegen.spec import ModuleSpec
 
-Stage = Callable[[str], AbstractContextManager[object]]
+__all__ = ["ENGINE_DIR", "Generator", "Stage", "environment", "manifest", "no_stage"]
 
 ENGINE_DIR = Path(__file__).resolve().parent
-
-
-def no_stage(name: str) -> AbstractContextManager[object]:
-    """The default stage hook: does nothing."""
-    return contextlib.nullcontext()
 
 
 def environment(template_dirs: Sequence[Path] = ()) -> jinja2.Environment:
@@ -40,8 +33,6 @@ def environment(template_dirs: Sequence[Path] = ()) -> jinja2.Environment:
     Templates are found in the engine's folder, then in ``template_dirs`` (a robot's own, for
     the bodies of hand-written kernels).
     """
-    from rpr3gen_derive.codegen.backends.c import comment
-
     env = jinja2.Environment(
         loader=jinja2.FileSystemLoader([ENGINE_DIR, *template_dirs]),
         undefined=jinja2.StrictUndefined,
@@ -52,52 +43,6 @@ def environment(template_dirs: Sequence[Path] = ()) -> jinja2.Environment:
     )
     env.filters["c_comment"] = comment
     return env
-
-
-def table_count(table: str) -> str:
-    """The count macro's suffix of a name table: ``output_names`` -> ``NUM_OUTPUTS``."""
-    return f"NUM_{table.removesuffix('_names').upper()}S"
-
-
-@dataclass(frozen=True)
-class Compiled:
-    """A function spec after common subexpression elimination, with what the backends need."""
-
-    spec: FunctionSpec
-    code: StraightLine
-    used_params: tuple[tuple[int, str], ...]  # (index in params, name)
-    used_inputs: tuple[tuple[str, int, str], ...]  # (input, index, symbol name)
-    slots: tuple[tuple[str, int], ...]  # flat output index -> (output, component index)
-
-    @property
-    def input_symbols(self) -> set[sp.Symbol]:
-        return {s for arg in self.spec.inputs for s in arg.symbols}
-
-
-def compile_function(spec: FunctionSpec, params: Argument) -> Compiled:
-    """Eliminate common subexpressions of ``spec`` and record which inputs it reads."""
-    flat = spec.flat_outputs()
-    if spec.c_body is not None:  # a hand-written kernel body: nothing to eliminate
-        return Compiled(spec, StraightLine((), (), 0, 0), (), (), tuple((o, k) for o, k, _ in flat))
-    code = straight_line(spec.program, [(f"{o}[{k}]", e) for o, k, e in flat])
-    used = set().union(*(rhs.free_symbols for _, rhs in code.assignments + code.outputs))
-    names = {str(s) for s in used}
-    unknown = names - {str(s) for s in params.symbols} - {str(s) for s, _ in code.assignments}
-    unknown -= {str(s) for arg in spec.inputs for s in arg.symbols}
-    if unknown:
-        raise ValueError(f"{spec.name}: symbols neither inputs nor parameters: {sorted(unknown)}")
-    return Compiled(
-        spec=spec,
-        code=code,
-        used_params=tuple((k, str(s)) for k, s in enumerate(params.symbols) if str(s) in names),
-        used_inputs=tuple(
-            (arg.name, k, str(s))
-            for arg in spec.inputs
-            for k, s in enumerate(arg.symbols)
-            if str(s) in names
-        ),
-        slots=tuple((o, k) for o, k, _ in flat),
-    )
 
 
 def _components(arg: Any) -> list[dict[str, str]]:
@@ -192,8 +137,6 @@ class Generator:
             return self._render_module(module, digest)
 
     def _render_module(self, module: ModuleSpec, digest: str) -> dict[str, str]:
-        from rpr3gen_derive.codegen.backends import c, python
-
         with self.stage("cse"):
             compiled = [compile_function(f, module.params) for f in module.functions]
         files: dict[str, str] = {}

@@ -18,10 +18,11 @@ from rpr3gen_derive.codegen import mathkernels
 from rpr3gen_derive.codegen.backends.c.batch import NotSplittableError, plan
 from rpr3gen_derive.codegen.backends.c.order import Line, schedule
 from rpr3gen_derive.codegen.backends.c.printer import c_code, fast_trig_arguments
+from rpr3gen_derive.codegen.compiled import table_count
 from rpr3gen_derive.codegen.spec import ModuleSpec
 
 if TYPE_CHECKING:
-    from rpr3gen_derive.codegen.render import Compiled, Stage
+    from rpr3gen_derive.codegen.compiled import Compiled, Stage
 
 
 WIDTH = 100
@@ -93,7 +94,6 @@ def _needed(lines: list[Line]) -> list[Line]:
 
 def _function(module: ModuleSpec, c: Compiled, values: bool = False) -> dict[str, Any]:
     """Template context of one function; ``values``: with its values-only kernel too."""
-    from rpr3gen_derive.codegen.render import table_count
 
     prefix, spec = module.prefix, c.spec
     upper = prefix.upper()
@@ -200,7 +200,6 @@ def render(
     stage: Stage,
 ) -> dict[str, tuple[str, str]]:
     """``{"c_header": (name, text), "c_source": (name, text)}`` of one module."""
-    from rpr3gen_derive.codegen.render import table_count
 
     with stage("print"):
         values = {name for c in compiled for name in c.spec.c_values}

@@ -11,10 +11,11 @@ from typing import TYPE_CHECKING
 import jinja2
 from rpr3gen_derive.codegen import mathkernels
 from rpr3gen_derive.codegen.backends.python.lowering import lower_numpy
+from rpr3gen_derive.codegen.compiled import table_count
 from rpr3gen_derive.codegen.spec import ModuleSpec
 
 if TYPE_CHECKING:
-    from rpr3gen_derive.codegen.render import Compiled, Stage
+    from rpr3gen_derive.codegen.compiled import Compiled, Stage
 
 
 def render(
@@ -25,7 +26,6 @@ def render(
     stage: Stage,
 ) -> dict[str, tuple[str, str]]:
     """``{"numpy": (file name, text)}`` of one module."""
-    from rpr3gen_derive.codegen.render import table_count
 
     functions = []
     with stage("print"):

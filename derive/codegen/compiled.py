@@ -1,0 +1,70 @@
+"""A function spec compiled for the backends: common subexpressions eliminated, the inputs and
+parameters it reads recorded; and the stage hook that times the engine's work.
+
+The engine (:mod:`.render`) compiles every spec once and hands the result to each backend; the
+backends import this module, never the engine.
+"""
+
+from __future__ import annotations
+
+import contextlib
+from collections.abc import Callable
+from contextlib import AbstractContextManager
+from dataclasses import dataclass
+
+import sympy as sp
+from rpr3gen_derive.codegen.cse import StraightLine, straight_line
+from rpr3gen_derive.codegen.spec import Argument, FunctionSpec
+
+Stage = Callable[[str], AbstractContextManager[object]]
+
+
+def no_stage(name: str) -> AbstractContextManager[object]:
+    """The default stage hook: does nothing."""
+    return contextlib.nullcontext()
+
+
+def table_count(table: str) -> str:
+    """The count macro's suffix of a name table: ``output_names`` -> ``NUM_OUTPUTS``."""
+    return f"NUM_{table.removesuffix('_names').upper()}S"
+
+
+@dataclass(frozen=True)
+class Compiled:
+    """A function spec after common subexpression elimination, with what the backends need."""
+
+    spec: FunctionSpec
+    code: StraightLine
+    used_params: tuple[tuple[int, str], ...]  # (index in params, name)
+    used_inputs: tuple[tuple[str, int, str], ...]  # (input, index, symbol name)
+    slots: tuple[tuple[str, int], ...]  # flat output index -> (output, component index)
+
+    @property
+    def input_symbols(self) -> set[sp.Symbol]:
+        return {s for arg in self.spec.inputs for s in arg.symbols}
+
+
+def compile_function(spec: FunctionSpec, params: Argument) -> Compiled:
+    """Eliminate common subexpressions of ``spec`` and record which inputs it reads."""
+    flat = spec.flat_outputs()
+    if spec.c_body is not None:  # a hand-written kernel body: nothing to eliminate
+        return Compiled(spec, StraightLine((), (), 0, 0), (), (), tuple((o, k) for o, k, _ in flat))
+    code = straight_line(spec.program, [(f"{o}[{k}]", e) for o, k, e in flat])
+    used = set().union(*(rhs.free_symbols for _, rhs in code.assignments + code.outputs))
+    names = {str(s) for s in used}
+    unknown = names - {str(s) for s in params.symbols} - {str(s) for s, _ in code.assignments}
+    unknown -= {str(s) for arg in spec.inputs for s in arg.symbols}
+    if unknown:
+        raise ValueError(f"{spec.name}: symbols neither inputs nor parameters: {sorted(unknown)}")
+    return Compiled(
+        spec=spec,
+        code=code,
+        used_params=tuple((k, str(s)) for k, s in enumerate(params.symbols) if str(s) in names),
+        used_inputs=tuple(
+            (arg.name, k, str(s))
+            for arg in spec.inputs
+            for k, s in enumerate(arg.symbols)
+            if str(s) in names
+        ),
+        slots=tuple((o, k) for o, k, _ in flat),
+    )
