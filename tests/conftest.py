@@ -1,12 +1,47 @@
-"""Shared fixtures: paths of the source tree."""
+"""Shared fixtures and session set-up: paths of the source tree, one C build cache per session,
+the long tests first.
+
+The suite runs on every core (``-n auto``, pytest-xdist, in ``pyproject.toml``). Its workers
+share one C build cache, a fresh folder per session unless ``RPR3GEN_CACHE_DIR`` is set (then
+that folder, and it is kept): each generated variant is compiled once per session, by whichever
+worker needs it first, while the others wait on the cache's lock (``rpr3gen.cbackend``). A
+fresh folder makes the suite's time the same on every run, and leaves the user's own cache
+alone.
+"""
 
 from __future__ import annotations
 
+import os
+import shutil
+import tempfile
 from pathlib import Path
 
 import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
+_CACHE_KEY = pytest.StashKey[str]()
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    # xdist's workers start after this runs in the controller, and inherit its environment.
+    if "RPR3GEN_CACHE_DIR" not in os.environ:
+        folder = tempfile.mkdtemp(prefix="rpr3gen-test-cache-")
+        os.environ["RPR3GEN_CACHE_DIR"] = folder
+        config.stash[_CACHE_KEY] = folder
+
+
+def pytest_unconfigure(config: pytest.Config) -> None:
+    folder = config.stash.get(_CACHE_KEY, None)
+    if folder is not None:
+        os.environ.pop("RPR3GEN_CACHE_DIR", None)
+        shutil.rmtree(folder, ignore_errors=True)
+
+
+@pytest.hookimpl(trylast=True)
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    """The tests marked ``slow`` first (stable: otherwise in collection order), so that on
+    several workers the long ones start at once rather than end the run on one worker."""
+    items.sort(key=lambda item: item.get_closest_marker("slow") is None)
 
 
 @pytest.fixture(scope="session")
