@@ -47,3 +47,15 @@ def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
 @pytest.fixture(scope="session")
 def repo_root() -> Path:
     return ROOT
+
+
+@pytest.fixture
+def quick_c_builds(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The c backend builds at -O0 in this test (half a second instead of seven): for tests of
+    the build cache or of a temporary generated folder, which need a library, not a fast one.
+    The flags are part of the cache key, so no other test meets these libraries."""
+    from rpr3gen import cbackend
+
+    flags = tuple("-O0" if f == "-O3" else f for f in cbackend.CFLAGS)
+    assert flags != cbackend.CFLAGS
+    monkeypatch.setattr(cbackend, "CFLAGS", flags)
