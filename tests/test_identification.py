@@ -22,6 +22,7 @@ import pytest
 import rpr3gen
 from rpr3gen import identification as idn
 from rpr3gen.cli import main
+from rpr3gen.excitation import Excitation
 from rpr3gen.model import Model
 
 ACTUATIONS = ("revolute", "prismatic")
@@ -299,14 +300,22 @@ def test_bad_samples_are_named() -> None:
 # Exciting trajectories.
 
 
+@functools.cache
+def _excited(identical: bool = False) -> Excitation:
+    """A short optimisation of an exciting motion for the paper robot (once per process: the
+    commands' tests below take their data along it)."""
+    model = rpr3gen.load_model()
+    return rpr3gen.excite(
+        model, harmonics=3, period=6.0, samples=61, max_iterations=25, identical_legs=identical
+    )
+
+
 @pytest.mark.parametrize("identical", [False, True], ids=["per-leg", "identical-legs"])
 def test_excite_lowers_the_condition_number_inside_the_workspace(identical: bool) -> None:
     """The optimised motion is better conditioned than the start and than the limit, and keeps
     every constraint, checked with the inverse dynamics (not the optimiser's own values)."""
     model = rpr3gen.load_model()
-    found = rpr3gen.excite(
-        model, harmonics=3, period=6.0, samples=61, max_iterations=25, identical_legs=identical
-    )
+    found = _excited(identical)
     assert found.condition_number < found.initial_condition_number / 3
     assert found.condition_number < idn.MAX_CONDITION
     traj = found.trajectory
@@ -341,8 +350,7 @@ def _write_data(path: Path, t, q, tau, family: str = "m10") -> Path:
 def _measured(tmp_path: Path) -> tuple[Path, Model, np.ndarray]:
     """Positions and efforts of a heavier robot along an exciting motion (noise-free)."""
     model = rpr3gen.load_model()
-    found = rpr3gen.excite(model, harmonics=3, period=6.0, samples=61, max_iterations=25)
-    motion = found.motion
+    motion = _excited().motion
     t = np.linspace(0.0, 2 * motion.period, 241)
     q, qd, qdd = motion.at(t)
     true = dataclasses.replace(model, params=dict(model.params) | {"m3": 6.5, "c1_perp": 0.01})
