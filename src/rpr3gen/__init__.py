@@ -32,6 +32,7 @@ from rpr3gen.design import WorkspaceMap, sweep, workspace, write_workspace
 from rpr3gen.errors import (
     GridError,
     IdentificationError,
+    IdentificationWarning,
     InputError,
     InputTypeError,
     ModelError,
@@ -66,6 +67,7 @@ __all__ = [
     "PARAM_NAMES",
     "GridError",
     "IdentificationError",
+    "IdentificationWarning",
     "InputError",
     "InputTypeError",
     "Model",

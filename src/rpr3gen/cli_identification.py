@@ -45,7 +45,7 @@ def _positive_float(text: str) -> float:
 
 def add_parsers(sub: argparse._SubParsersAction, paper_model: str) -> None:
     """The ``identify`` and ``excite`` subcommands."""
-    from rpr3gen.identification import MAX_CONDITION
+    from rpr3gen.identification import MAX_CONDITION, WARN_CONDITION
 
     ide = sub.add_parser(
         "identify",
@@ -74,11 +74,20 @@ def add_parsers(sub: argparse._SubParsersAction, paper_model: str) -> None:
         "(m, rad; default 0: through every sample; give the measurement noise)",
     )
     ide.add_argument(
+        "--warn-condition",
+        type=_positive_float,
+        default=WARN_CONDITION,
+        metavar="K",
+        help="fit, with a warning naming the most inflated standard deviations, data whose "
+        f"condition number exceeds K (default {WARN_CONDITION:g})",
+    )
+    ide.add_argument(
         "--max-condition",
         type=_positive_float,
         default=MAX_CONDITION,
         metavar="K",
-        help=f"refuse data whose condition number exceeds K (default {MAX_CONDITION:g})",
+        help=f"refuse data whose condition number exceeds K (default {MAX_CONDITION:g}: beyond "
+        "it measured data cannot be told from data that leave a parameter undetermined)",
     )
     ide.add_argument("--out", metavar="FILE.toml", help="write the estimates as TOML")
     ide.add_argument(
@@ -183,6 +192,7 @@ def cmd_identify(args: argparse.Namespace) -> int:
         tau,
         friction=args.friction,
         identical_legs=args.identical_legs,
+        warn_condition=args.warn_condition,
         max_condition=args.max_condition,
         t=traj.t,
         backend=args.backend,
@@ -203,7 +213,8 @@ def cmd_identify(args: argparse.Namespace) -> int:
         + (" + 6 friction" if args.friction else "")
     )
     print(
-        f"  condition number {fit.condition_number:.4g} (limit {args.max_condition:g}); "
+        f"  condition number {fit.condition_number:.4g} (warns above {args.warn_condition:g}, "
+        f"refuses above {args.max_condition:g}); "
         f"residual RMS {fit.residual_rms:.4g} {unit} ({per})"
     )
     print(f"  {'parameter':<10} {'estimate':>13} {'std':>11} {'model':>13}  stands for")
