@@ -37,7 +37,6 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.linalg
 
 __all__ = ["MAX_CONDITION", "WARN_CONDITION", "Assessment", "assess", "combinations"]
 
@@ -111,6 +110,8 @@ def combinations(names: Sequence[str], assessment: Assessment, fraction: float) 
     directions = assessment.below(fraction)
     if not len(directions):
         return []
+    import scipy.linalg  # here, not at the top: `import rpr3gen` (every command) stays quick
+
     _, _, pivots = scipy.linalg.qr(directions, pivoting=True, mode="economic")
     lead = pivots[: len(directions)]
     echelon = np.linalg.solve(directions[:, lead], directions)

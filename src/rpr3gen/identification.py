@@ -25,7 +25,6 @@ from functools import lru_cache, wraps
 from typing import ParamSpec, TypeVar
 
 import numpy as np
-import scipy.linalg
 from numpy.typing import ArrayLike
 from threadpoolctl import threadpool_limits
 
@@ -256,6 +255,8 @@ def _base_parameters(model: Model, identical_legs: bool) -> BaseParameters:
     order = [names.index(n) for n in _preference(identical_legs)]
     # QR without pivoting in the order of preference: a column is dependent on the ones before
     # it when what remains of it is round-off against its norm.
+    import scipy.linalg  # here, not at the top: `import rpr3gen` (every command) stays quick
+
     R = scipy.linalg.qr(W[:, order], mode="r")[0]
     base = sorted(
         order[k]
@@ -568,6 +569,8 @@ def identify(
     weighted = y - W @ x
     sigma2 = float(weighted @ weighted) / (3 * n - p)
     R = np.linalg.qr(W, mode="r")
+    import scipy.linalg
+
     Rinv = scipy.linalg.solve_triangular(R, np.eye(p))
     std = np.sqrt(sigma2 * np.sum(Rinv**2, axis=1))
     residual = rhs - columns @ x
