@@ -580,6 +580,7 @@ def test_cli_excite_writes_a_trajectory(tmp_path: Path, capsys) -> None:
     assert len(traj) == 61
 
 
+@pytest.mark.slow
 def test_the_example_writes_data_that_identify_reads(tmp_path: Path, capsys) -> None:
     """examples/identification: the script's data recover its true platform mass."""
     import runpy
