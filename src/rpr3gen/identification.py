@@ -425,8 +425,9 @@ def _refusal(names: tuple[str, ...], check: Assessment, max_condition: float) ->
     p = len(names)
     advice = "; use a richer motion (rpr3gen excite)"
     if check.rank < p:
-        exact = check.singular_values[check.rank - 1] / check.singular_values[0] / 2
-        undetermined = "; ".join(combinations(names, check, exact))
+        s = check.singular_values  # below half the smallest non-zero one: the zero ones
+        zero = s[check.rank - 1] / s[0] / 2 if check.rank else 1.0
+        undetermined = "; ".join(combinations(names, check, zero))
         return (
             f"the data do not excite every parameter (rank {check.rank} of {p}): no effort "
             f"changes with {undetermined}, left undetermined{advice}"
