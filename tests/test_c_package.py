@@ -96,7 +96,7 @@ def test_every_variant_folder_is_a_package(repo_root: Path) -> None:
     """Whatever variants the engine writes, each has its CMake project and pkg-config file,
     with the generated files' header, named in its manifest."""
     folders = sorted(p.parent for p in (repo_root / "generated").glob("*/manifest.json"))
-    assert [f.name for f in folders] == sorted(VARIANTS)
+    assert set(VARIANTS) <= {f.name for f in folders}  # and any variant added later
     for folder in folders:
         data = json.loads((folder / "manifest.json").read_text())
         pc = f"rpr3gen_{folder.name}.pc.in"
