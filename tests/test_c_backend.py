@@ -4,6 +4,7 @@ batch split across threads gives the same bits as one thread)."""
 from __future__ import annotations
 
 import ctypes
+import os
 import shutil
 import subprocess
 import sys
@@ -207,6 +208,7 @@ def test_threads_get_the_same_results() -> None:
             assert out[name].tobytes() == want[name].tobytes()
 
 
+@pytest.mark.usefixtures("quick_c_builds")
 def test_build_is_cached_and_rebuilt_when_the_source_changes(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -223,7 +225,64 @@ def test_build_is_cached_and_rebuilt_when_the_source_changes(
     second = cbackend.library_path(variant)
     assert second != first
     assert second.is_file()
-    assert sorted(p.name for p in tmp_path.iterdir()) == sorted([first.name, second.name])
+    libraries = [first.name, second.name]
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(
+        libraries + [f".{name}.lock" for name in libraries]  # no build folder left behind
+    )
+
+
+#: A process that builds the revolute library (at -O0) when told to, and prints its path and
+#: the first outputs of one sample through it.
+_BUILDER = """
+import sys
+import numpy as np
+import rpr3gen
+from rpr3gen import cbackend, manifest
+cbackend.CFLAGS = tuple("-O0" if f == "-O3" else f for f in cbackend.CFLAGS)
+variant = manifest.load("revolute")
+print("ready", flush=True)
+assert sys.stdin.readline() == "go\\n"
+path = cbackend.library_path(variant)
+model = rpr3gen.load_model()
+q = np.array([[0.01, -0.02, 0.1]])
+out = rpr3gen.inverse_dynamics(model, q, q, q, backend="c")
+print(path, out["m10_A"][0].hex(), out["f32z_C"][0].hex(), flush=True)
+"""
+
+
+def test_concurrent_first_builds_compile_once(tmp_path: Path) -> None:
+    """Three processes ask for the same library at once in an empty cache (as test workers do):
+    one compiles it, the others wait on the lock and load the same file."""
+    cc = shutil.which("cc") or shutil.which("gcc")
+    assert cc, "a C compiler is required by the test suite"
+    log = tmp_path / "cc.log"
+    wrapper = tmp_path / "cc-logged"  # counts the compiler's runs
+    wrapper.write_text(f'#!/bin/sh\necho "$@" >> "{log}"\nexec "{cc}" "$@"\n')
+    wrapper.chmod(0o755)
+    cache = tmp_path / "cache"
+    env = dict(os.environ, CC=str(wrapper), RPR3GEN_CACHE_DIR=str(cache))
+    pipes = {"stdin": subprocess.PIPE, "stdout": subprocess.PIPE, "stderr": subprocess.PIPE}
+    builders = [
+        subprocess.Popen([sys.executable, "-c", _BUILDER], text=True, env=env, **pipes)
+        for _ in range(3)
+    ]
+    for p in builders:  # every process is ready (imported, about to build) ...
+        assert p.stdout is not None
+        assert p.stdout.readline() == "ready\n"
+    for p in builders:  # ... before any is told to build
+        assert p.stdin is not None
+        p.stdin.write("go\n")
+        p.stdin.flush()
+    results = [p.communicate() for p in builders]
+    assert [p.returncode for p in builders] == [0] * 3, [err for _, err in results]
+    lines = {out for out, _ in results}
+    assert len(lines) == 1  # the same library, the same bits
+    (path, *_values) = lines.pop().split()
+    assert Path(path).parent == cache
+    assert len(log.read_text().splitlines()) == 1  # compiled once
+    assert sorted(p.name for p in cache.iterdir()) == sorted(
+        [Path(path).name, f".{Path(path).name}.lock"]
+    )
 
 
 def test_missing_compiler_is_one_clear_line(tmp_path: Path) -> None:

@@ -67,20 +67,33 @@ def _check_tracking(text: str, actuation: str, trajectory: str) -> dict[str, flo
     return numbers
 
 
-@pytest.fixture(scope="module")
-def c_build(repo_root: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """Both C programs, built with -Werror, and the paper robot's parameter file."""
-    work = tmp_path_factory.mktemp("control_loop")
+@pytest.fixture(scope="module", params=["make", "cmake"])
+def c_build(
+    request: pytest.FixtureRequest, repo_root: Path, tmp_path_factory: pytest.TempPathFactory
+) -> Path:
+    """Both C programs, built with -Werror by the Makefile or by CMakeLists.txt (each variant
+    through its CMake package), and the paper robot's parameter file, in one folder."""
+    work = tmp_path_factory.mktemp(f"control_loop_{request.param}")
     example = repo_root / "examples" / "control_loop"
-    for name in ("Makefile", "control_loop.c"):
-        shutil.copy(example / name, work / name)
-    flags = "CFLAGS=-std=c99 -O2 -Wall -Wextra -pedantic -Werror"
-    generated = f"GENERATED={repo_root / 'generated'}"
-    result = subprocess.run(
-        ["make", "-s", generated, flags], cwd=work, capture_output=True, text=True, check=False
-    )
-    assert result.returncode == 0, result.stdout + result.stderr
-    assert result.stderr == "", result.stderr  # no warnings either
+    warnings = "-Wall -Wextra -pedantic -Werror"
+    if request.param == "make":
+        for name in ("Makefile", "control_loop.c"):
+            shutil.copy(example / name, work / name)
+        flags = f"CFLAGS=-std=c99 -O2 {warnings}"
+        generated = f"GENERATED={repo_root / 'generated'}"
+        commands = [["make", "-s", generated, flags]]
+    else:
+        cmake = shutil.which("cmake")
+        if cmake is None:
+            pytest.skip("cmake is not installed")
+        # Debug (no optimisation): the build is what is tested here, the make build is -O2.
+        configure = [cmake, "-S", str(example), "-B", str(work), "-DCMAKE_BUILD_TYPE=Debug",
+                     f"-DCMAKE_C_FLAGS={warnings}"]  # fmt: skip
+        commands = [configure, [cmake, "--build", str(work)]]
+    for command in commands:
+        result = subprocess.run(command, cwd=work, capture_output=True, text=True, check=False)
+        assert result.returncode == 0, result.stdout + result.stderr
+        assert result.stderr == "", result.stderr  # no warnings either
     out = io.StringIO()
     with contextlib.redirect_stdout(out):
         assert main(["params"]) == 0

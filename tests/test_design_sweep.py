@@ -153,8 +153,24 @@ def _free_port() -> int:
         return int(s.getsockname()[1])
 
 
+@pytest.fixture(scope="session")
+def stopping() -> Iterator[list[subprocess.Popen[bytes]]]:
+    """Processes told to stop, waited for at the end of the session: a ``dask worker`` takes
+    seconds to exit after its nanny has closed it, time the other tests can use meanwhile."""
+    procs: list[subprocess.Popen[bytes]] = []
+    yield procs
+    for proc in procs:
+        try:
+            proc.wait(timeout=60)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.wait()
+
+
 @pytest.fixture(scope="module")
-def scheduler(tmp_path_factory: pytest.TempPathFactory) -> Iterator[str]:
+def scheduler(
+    tmp_path_factory: pytest.TempPathFactory, stopping: list[subprocess.Popen[bytes]]
+) -> Iterator[str]:
     """A ``dask scheduler`` and two ``dask worker`` processes on localhost; their address."""
     from distributed import Client
 
@@ -179,12 +195,7 @@ def scheduler(tmp_path_factory: pytest.TempPathFactory) -> Iterator[str]:
     finally:
         for proc in reversed(procs):
             proc.terminate()
-        for proc in reversed(procs):
-            try:
-                proc.wait(timeout=60)
-            except subprocess.TimeoutExpired:
-                proc.kill()
-                proc.wait()
+        stopping.extend(reversed(procs))
 
 
 @pytest.mark.slow

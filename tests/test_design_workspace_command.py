@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
+import matplotlib.colors
 import numpy as np
 import pyarrow.parquet as pq
 import pytest
@@ -67,3 +68,25 @@ def test_a_file_in_the_way_of_the_folder(
     assert main(["workspace", "--resolution", "8", "--out", str(blocker)]) == 2
     assert "is a file, not a folder" in capsys.readouterr().err
     assert blocker.read_text() == "not a folder"
+
+
+def test_the_peak_effort_scale_ends_at_the_95th_percentile() -> None:
+    """Points just above the conditioning floor would take the whole colour scale: it ends at
+    the 95th percentile of the reachable points' efforts, and the figure says what is above."""
+    from rpr3gen.design import figures
+
+    wmap = rpr3gen.workspace(rpr3gen.load_model(), 0.0, 60)
+    peak = np.max(np.abs(wmap.tau), axis=2)
+    efforts = peak[np.isfinite(peak)]
+    top = np.percentile(efforts, 95)
+    assert efforts.max() > 10 * top  # the paper robot's map needs it
+    fig = figures.effort_figure(wmap)
+    (image,) = fig.axes[0].get_images()
+    assert image.norm.vmin == efforts.min()
+    assert image.norm.vmax == pytest.approx(top, rel=1e-12)
+    assert image.cmap.get_over() == pytest.approx(matplotlib.colors.to_rgba(figures.OVER_COLOR))
+    assert fig.axes[1].get_ylabel().endswith("(log scale, to the 95th percentile)")
+    (legend,) = fig.legends
+    share = np.count_nonzero(efforts > top) / efforts.size
+    label = f"above the scale: {top:,.0f} to {efforts.max():,.0f} N·m ({share:.1%} of the points)"
+    assert label in [t.get_text() for t in legend.get_texts()]

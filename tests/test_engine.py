@@ -93,6 +93,7 @@ def _reference_lengths(model: rpr3gen.Model, q: np.ndarray) -> np.ndarray:
     return np.stack(columns, axis=1)
 
 
+@pytest.mark.usefixtures("quick_c_builds")
 @pytest.mark.parametrize("actuation", ACTUATIONS)
 def test_a_toy_spec_is_rendered_compiled_and_called_by_name(
     toy_folder: Path, actuation: str
@@ -135,6 +136,7 @@ def test_a_toy_spec_is_rendered_compiled_and_called_by_name(
         assert here[name].tobytes() == packaged[name].tobytes()
 
 
+@pytest.mark.usefixtures("quick_c_builds")
 @pytest.mark.parametrize("actuation", ACTUATIONS)
 def test_toy_single_call_matches_batch(toy_folder: Path, actuation: str) -> None:
     model = _model(actuation, toy_folder)

@@ -46,3 +46,13 @@ def test_generate_without_derive_dependencies_is_one_clear_line() -> None:
     assert result.stderr.count("\n") == 1
     assert "rpr3gen[derive]" in result.stderr
     assert "Traceback" not in result.stderr
+
+
+def test_importing_the_runtime_leaves_scipy_for_later() -> None:
+    """``import rpr3gen``, which every command does, does not pay for SciPy (0.7 s of imports):
+    the identification and the positions-only trajectories import it when they run."""
+    code = "import sys, rpr3gen.cli; print(sorted({m.split('.')[0] for m in sys.modules}))"
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert result.returncode == 0, result.stderr
+    assert "'numpy'" in result.stdout
+    assert "'scipy'" not in result.stdout

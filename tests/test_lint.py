@@ -14,7 +14,7 @@ import pytest
     [
         ["ruff", "check", "."],
         ["ruff", "format", "--check", "."],
-        ["mypy"],
+        pytest.param(["mypy"], marks=pytest.mark.slow),  # 8 s without its cache
     ],
     ids=["ruff-check", "ruff-format", "mypy"],
 )

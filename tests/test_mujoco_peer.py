@@ -338,6 +338,7 @@ def test_generated_forward_dynamics_moves_like_mujoco(actuation: str) -> None:
     assert departure > 100 * max_orientation
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("actuation", ACTUATIONS)
 def test_mujoco_converges_to_the_generated_forward_dynamics(actuation: str) -> None:
     """Ten times smaller dt and timeconst: MuJoCo's distance to rpr3gen's motion drops ~100x

@@ -33,6 +33,7 @@ from rpr3gen.design import WorkspaceMap, sweep, workspace, write_workspace
 from rpr3gen.errors import (
     GridError,
     IdentificationError,
+    IdentificationWarning,
     InputError,
     InputTypeError,
     ModelError,
@@ -67,6 +68,7 @@ __all__ = [
     "PARAM_NAMES",
     "GridError",
     "IdentificationError",
+    "IdentificationWarning",
     "InputError",
     "InputTypeError",
     "Model",

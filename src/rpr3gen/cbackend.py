@@ -3,8 +3,13 @@
 The shared library is built on first use with the system compiler (``$CC`` or ``cc``) into a
 per-user cache folder (``$RPR3GEN_CACHE_DIR``, else ``$XDG_CACHE_HOME/rpr3gen``, else
 ``~/.cache/rpr3gen``), named by a SHA-256 of the C sources, the shim and the compile command, so
-a changed source is rebuilt and an unchanged one is reused. The build goes to a temporary file
-renamed into place, so concurrent first uses are safe.
+a changed source is rebuilt and an unchanged one is reused. Concurrent first uses (threads, or
+processes such as test workers sharing the cache) are safe and build once: the build goes to a
+temporary folder and is renamed into place (a reader never sees half a library), under an
+exclusive lock on a file beside the library (``.{library}.lock``, kept), which a process waiting
+for it takes after the build and then finds the library built. The lock is ``flock``'s, released
+by the system when its holder dies, so a crashed build never blocks the next one; where
+``fcntl`` is missing (Windows) builds are not serialised, only renamed atomically.
 
 The binding is derived from the manifest (:mod:`rpr3gen.manifest`): every function takes
 ``params``, its inputs and its outputs as pointers, and its batch ``params, n, inputs...,
@@ -15,6 +20,7 @@ argument instead of several, which halves the cost of a call from Python.
 
 from __future__ import annotations
 
+import contextlib
 import ctypes
 import hashlib
 import os
@@ -22,9 +28,15 @@ import shlex
 import shutil
 import subprocess
 import tempfile
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
+
+try:
+    import fcntl
+except ImportError:  # pragma: no cover - Windows: atomic renames only
+    fcntl = None  # type: ignore[assignment]
 
 from rpr3gen.errors import Rpr3genError
 from rpr3gen.loader import check_files
@@ -99,6 +111,20 @@ def shim(variant: Variant) -> bytes:
     return "\n".join(lines).encode()
 
 
+@contextlib.contextmanager
+def _exclusive(lock: Path) -> Iterator[None]:
+    """Hold an exclusive lock on the file ``lock`` (created if missing) for the block."""
+    if fcntl is None:  # pragma: no cover
+        yield
+        return
+    fd = os.open(lock, os.O_RDWR | os.O_CREAT, 0o644)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX)
+        yield
+    finally:
+        os.close(fd)  # releases the lock
+
+
 def library_path(variant: Variant) -> Path:
     """Path of the compiled library of ``variant``, building it if it is not in the cache."""
     source, header = sources(variant)
@@ -113,12 +139,20 @@ def library_path(variant: Variant) -> Path:
     if target.is_file():
         return target
     folder.mkdir(parents=True, exist_ok=True)
-    with tempfile.TemporaryDirectory(dir=folder, prefix=".build-") as tmp:
-        files = {
-            variant.files["c_source"]: source,
-            variant.files["c_header"]: header,
-            "shim.c": glue,
-        }
+    with _exclusive(folder / f".{target.name}.lock"):
+        if not target.is_file():  # else built by another process while this one waited
+            files = {
+                variant.files["c_source"]: source,
+                variant.files["c_header"]: header,
+                "shim.c": glue,
+            }
+            _build(variant, command, files, target)
+    return target
+
+
+def _build(variant: Variant, command: list[str], files: dict[str, bytes], target: Path) -> None:
+    """Compile ``files`` into ``target``: in a temporary folder beside it, then renamed."""
+    with tempfile.TemporaryDirectory(dir=target.parent, prefix=".build-") as tmp:
         for name, text in files.items():
             (Path(tmp) / name).write_bytes(text)
         built = Path(tmp) / target.name
@@ -137,7 +171,6 @@ def library_path(variant: Variant) -> Path:
             first = (result.stderr.strip().splitlines() or ["(no message)"])[0]
             raise Rpr3genError(f"compiling the generated C of {variant.folder} failed: {first}")
         os.replace(built, target)
-    return target
 
 
 @dataclass(frozen=True)

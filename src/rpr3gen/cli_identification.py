@@ -26,7 +26,7 @@ UNIT = {"revolute": "N m", "prismatic": "N"}
 
 def add_parsers(sub: argparse._SubParsersAction, paper_model: str) -> None:
     """The ``identify`` and ``excite`` subcommands."""
-    from rpr3gen.identification import MAX_CONDITION
+    from rpr3gen.identification import MAX_CONDITION, WARN_CONDITION
 
     ide = sub.add_parser(
         "identify",
@@ -55,11 +55,20 @@ def add_parsers(sub: argparse._SubParsersAction, paper_model: str) -> None:
         "(m, rad; default 0: through every sample; give the measurement noise)",
     )
     ide.add_argument(
+        "--warn-condition",
+        type=number(finite=False, greater=1.0),
+        default=WARN_CONDITION,
+        metavar="K",
+        help="fit, with a warning naming the most inflated standard deviations, data whose "
+        f"condition number exceeds K (default {WARN_CONDITION:g})",
+    )
+    ide.add_argument(
         "--max-condition",
         type=number(finite=False, greater=1.0),
         default=MAX_CONDITION,
         metavar="K",
-        help=f"refuse data whose condition number exceeds K (default {MAX_CONDITION:g})",
+        help=f"refuse data whose condition number exceeds K (default {MAX_CONDITION:g}: beyond "
+        "it measured data cannot be told from data that leave a parameter undetermined)",
     )
     ide.add_argument("--out", metavar="FILE.toml", help="write the estimates as TOML")
     ide.add_argument(
@@ -169,6 +178,7 @@ def cmd_identify(args: argparse.Namespace) -> int:
         tau,
         friction=args.friction,
         identical_legs=args.identical_legs,
+        warn_condition=args.warn_condition,
         max_condition=args.max_condition,
         t=traj.t,
         backend=args.backend,
@@ -191,7 +201,8 @@ def cmd_identify(args: argparse.Namespace) -> int:
         + (" + 6 friction" if args.friction else "")
     )
     print(
-        f"  condition number {fit.condition_number:.4g} (limit {args.max_condition:g}); "
+        f"  condition number {fit.condition_number:.4g} (warns above {args.warn_condition:g}, "
+        f"refuses above {args.max_condition:g}); "
         f"residual RMS {fit.residual_rms:.4g} {unit} ({per})"
     )
     print(f"  {'parameter':<10} {'estimate':>13} {'std':>11} {'model':>13}  stands for")

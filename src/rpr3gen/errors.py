@@ -13,13 +13,15 @@ derive from :class:`ValueError`, and those about a value of the wrong type from
     ├── TrajectoryError(Rpr3genError, ValueError)   a trajectory file or request
     ├── GridError(Rpr3genError, ValueError)         a design-study grid file or mapping
     ├── InputError(Rpr3genError, ValueError)        an array or argument of the Python API
+    ├── IdentificationError(Rpr3genError, ValueError)  data that do not determine the fit
     └── InputTypeError(Rpr3genError, TypeError)     an argument of the wrong type
 
 Warnings (``warnings.warn``) derive from :class:`Rpr3genWarning`, a :class:`UserWarning`; the
 command line prints each as one line ``rpr3gen: warning: <msg>`` on stderr::
 
     Rpr3genWarning(UserWarning)
-    └── TrajectoryWarning   a trajectory file's derivatives disagree with its positions
+    ├── TrajectoryWarning       a trajectory file's derivatives disagree with its positions
+    └── IdentificationWarning   identification data excite some parameters only weakly
 """
 
 from __future__ import annotations
@@ -29,6 +31,8 @@ from collections.abc import Iterable
 
 __all__ = [
     "GridError",
+    "IdentificationError",
+    "IdentificationWarning",
     "InputError",
     "InputTypeError",
     "ModelError",
@@ -86,6 +90,11 @@ class Rpr3genWarning(UserWarning):
 class TrajectoryWarning(Rpr3genWarning):
     """A trajectory's velocities or accelerations disagree with its positions, or its spline
     could not be fitted as asked."""
+
+
+class IdentificationWarning(Rpr3genWarning):
+    """Identification data whose condition number is above the documented bound: the fit is
+    kept, with standard deviations that the motion inflates (rpr3gen.identifiability)."""
 
 
 def did_you_mean(word: str, choices: Iterable[str]) -> str:

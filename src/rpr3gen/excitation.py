@@ -23,7 +23,6 @@ from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
-import scipy.optimize
 
 from rpr3gen import sizes, variants
 from rpr3gen.backends import evaluate
@@ -272,6 +271,8 @@ def excite(
             "limits, conditioning, reach); relax them"
         )
     initial = math.exp(log_cond(start))
+    import scipy.optimize  # here, not at the top: `import rpr3gen` (every command) stays quick
+
     result = scipy.optimize.minimize(
         log_cond,
         start,

@@ -18,20 +18,21 @@ actuations). :func:`identify` estimates them by weighted least squares.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+import warnings
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from functools import lru_cache, wraps
 from typing import ParamSpec, TypeVar
 
 import numpy as np
-import scipy.linalg
 from numpy.typing import ArrayLike
 from threadpoolctl import threadpool_limits
 
 from rpr3gen import sizes, variants
 from rpr3gen.backends import evaluate
 from rpr3gen.control import actuator_jacobian, platform_radius
-from rpr3gen.errors import IdentificationError, InputError, Rpr3genError
+from rpr3gen.errors import IdentificationError, IdentificationWarning, InputError, Rpr3genError
+from rpr3gen.identifiability import MAX_CONDITION, WARN_CONDITION, Assessment, assess, combinations
 from rpr3gen.model import LEGS, Model
 from rpr3gen.validation import Number, Optional, Reading, Rows, Sample, checked
 
@@ -39,9 +40,11 @@ __all__ = [
     "INERTIAL_PARAMETER_NAMES",
     "MAX_CONDITION",
     "SHARED_PARAMETER_NAMES",
+    "WARN_CONDITION",
     "BaseParameters",
     "Fit",
     "IdentificationError",
+    "IdentificationWarning",
     "base_parameters",
     "base_regressor",
     "friction_columns",
@@ -67,11 +70,6 @@ INERTIAL_PARAMETER_NAMES: tuple[str, ...] = tuple(
 SHARED_PARAMETER_NAMES: tuple[str, ...] = tuple(
     f"{q}_{body}" for body in ("1", "2", "3") for q in QUANTITIES
 )
-
-#: The largest condition number of the stacked base regressor (columns scaled to unit norm)
-#: that :func:`identify` accepts: beyond it the data do not excite every base parameter, and
-#: noise of 0.1 % in the efforts could move some estimate by its own size or more.
-MAX_CONDITION = 1e3
 
 
 #: The order in which base parameters are chosen (the others are regrouped into them): the
@@ -289,6 +287,8 @@ def _base_parameters(model: Model, identical_legs: bool) -> BaseParameters:
     order = [names.index(n) for n in _preference(identical_legs)]
     # QR without pivoting in the order of preference: a column is dependent on the ones before
     # it when what remains of it is round-off against its norm.
+    import scipy.linalg  # here, not at the top: `import rpr3gen` (every command) stays quick
+
     R = scipy.linalg.qr(W[:, order], mode="r")[0]
     base = sorted(
         order[k]
@@ -385,6 +385,9 @@ class Fit:
         residual_rms_per_actuator: (3,) the same per actuator.
         condition_number: of the stacked regressor (base and friction columns, unweighted,
             scaled to unit norm): how well the motion excites the parameters.
+        inflation: (len(names),) how much the motion inflates each standard deviation: its
+            ratio to what it would be with that parameter's column orthogonal to the others
+            (the square root of the variance inflation factor; 1 at best).
         weights: (3,) the weight of each actuator's rows (1 / its residual std).
         samples: the number of samples used.
         base: the base parameters (what ``values[:B]`` stand for).
@@ -399,6 +402,7 @@ class Fit:
     residual_rms: float
     residual_rms_per_actuator: np.ndarray
     condition_number: float
+    inflation: np.ndarray
     weights: np.ndarray
     samples: int
     base: BaseParameters
@@ -451,23 +455,41 @@ def _design(
     return Yb
 
 
-def _condition(W: np.ndarray) -> tuple[float, np.ndarray, np.ndarray]:
-    """Condition number of W with unit-norm columns, its singular values and right vectors."""
-    scale = np.linalg.norm(W, axis=0)
-    scale[scale == 0] = 1.0
-    _, s, vt = np.linalg.svd(W / scale, full_matrices=False)
-    cond = float(s[0] / s[-1]) if s[-1] > 0 else math.inf
-    return cond, s, vt
+def _refusal(names: tuple[str, ...], check: Assessment, max_condition: float) -> str | None:
+    """Why the data cannot give the parameters (naming what they leave undetermined), or None."""
+    p = len(names)
+    advice = "; use a richer motion (rpr3gen excite)"
+    if check.rank < p:
+        s = check.singular_values  # below half the smallest non-zero one: the zero ones
+        zero = s[check.rank - 1] / s[0] / 2 if check.rank else 1.0
+        undetermined = "; ".join(combinations(names, check, zero))
+        return (
+            f"the data do not excite every parameter (rank {check.rank} of {p}): no effort "
+            f"changes with {undetermined}, left undetermined{advice}"
+        )
+    if not check.condition_number <= max_condition:
+        weak = "; ".join(combinations(names, check, 1.0 / max_condition))
+        return (
+            f"the data do not excite every parameter (condition number "
+            f"{check.condition_number:.3g} > {max_condition:.3g}: an error of the data within "
+            f"their own accuracy could make them rank-deficient): {weak} practically "
+            f"undetermined{advice}"
+        )
+    return None
 
 
-def _weak_parameters(names: Sequence[str], s: np.ndarray, vt: np.ndarray, limit: float) -> str:
-    """The parameters the data leave (nearly) undetermined: the large components of the right
-    singular vectors whose singular value is under ``s[0] / limit``."""
-    weak: set[str] = set()
-    for k in np.flatnonzero(s < s[0] / limit):
-        v = np.abs(vt[k])
-        weak.update(names[int(j)] for j in np.flatnonzero(v >= 0.3 * v.max()))
-    return ", ".join(n for n in names if n in weak)
+def _inflated(fit: Fit, warn_condition: float, most: int = 5) -> str:
+    """The warning of a fit above ``warn_condition``: the most inflated estimates."""
+    order = np.argsort(-fit.inflation, kind="stable")[:most]
+    worst = ", ".join(
+        f"{fit.names[k]} {fit.values[k]:.4g} ± {fit.std[k]:.3g} (std x{fit.inflation[k]:.3g})"
+        for k in order
+    )
+    return (
+        f"condition number {fit.condition_number:.3g} > {warn_condition:.3g}: the motion "
+        f"excites some parameters weakly; fitted, but their standard deviations are inflated, "
+        f"most of: {worst}"
+    )
 
 
 @checked(
@@ -476,6 +498,7 @@ def _weak_parameters(names: Sequence[str], s: np.ndarray, vt: np.ndarray, limit:
     qdd=Rows(3),
     tau=Rows(3),
     weights=Optional(Reading(3, positive=True)),
+    warn_condition=Number(finite=False, greater=1.0),
     max_condition=Number(finite=False, greater=1.0),
     t=Optional(Sample()),
     same_length=[("q", "qd", "qdd", "tau", "t")],
@@ -491,6 +514,7 @@ def identify(
     identical_legs: bool = False,
     *,
     weights: ArrayLike | None = None,
+    warn_condition: float = WARN_CONDITION,
     max_condition: float = MAX_CONDITION,
     t: ArrayLike | None = None,
     backend: str = "numpy",
@@ -514,7 +538,10 @@ def identify(
         identical_legs: the legs share one set of parameters (B = 9 instead of 19).
         weights: (3,) the weight of each actuator's rows instead of the automatic ones
             (positive; only their ratios count).
-        max_condition: the largest condition number accepted (default :data:`MAX_CONDITION`).
+        warn_condition: above this condition number the fit warns (default
+            :data:`WARN_CONDITION`, 1e3; :mod:`rpr3gen.identifiability` says why).
+        max_condition: the largest condition number accepted (default :data:`MAX_CONDITION`,
+            1e5, the hard bound).
         t: (n,) the samples' times, only to name a bad sample in an error.
         backend: ``"numpy"`` or ``"c"`` for the generated regressor.
 
@@ -522,7 +549,12 @@ def identify(
         InputError: bad shapes, a value not finite, a singular pose (naming its sample).
         IdentificationError: fewer equations than unknowns, or data that do not excite every
             parameter (rank-deficient, or condition number above ``max_condition``): the
-            message names the parameters left undetermined.
+            message names the combinations of parameters left undetermined.
+
+    Warns:
+        IdentificationWarning: condition number above ``warn_condition`` (and not above
+            ``max_condition``): the fit is returned, and the warning names the estimates whose
+            standard deviations the motion inflates most.
     """
     q, qd, qdd, tau = (np.asarray(a) for a in (q, qd, qdd, tau))  # (n, 3) each: checked
     times = None if t is None else np.asarray(t)  # (n,), finite: checked
@@ -560,15 +592,10 @@ def identify(
         x = np.linalg.lstsq(W, y, rcond=None)[0]
         return x, W, y
 
-    cond, s, vt = _condition(columns.reshape(-1, p))
-    if not cond <= max_condition:
-        rank = int(np.sum(s > s[0] * 1e-10))
-        deficient = f"rank {rank} of {p}, " if rank < p else ""
-        raise IdentificationError(
-            f"the data do not excite every parameter ({deficient}condition number {cond:.3g} "
-            f"> {max_condition:.3g}): {_weak_parameters(names, s, vt, max_condition)} left "
-            "undetermined; use a richer motion (rpr3gen excite)"
-        )
+    check = assess(columns.reshape(-1, p))
+    refusal = _refusal(names, check, max_condition)
+    if refusal is not None:
+        raise IdentificationError(refusal)
     if weights is None:
         x, _, _ = solve(np.ones(3))
         r = (rhs - columns @ x).reshape(n, 3)
@@ -583,16 +610,19 @@ def identify(
     weighted = y - W @ x
     sigma2 = float(weighted @ weighted) / (3 * n - p)
     R = np.linalg.qr(W, mode="r")
+    import scipy.linalg
+
     Rinv = scipy.linalg.solve_triangular(R, np.eye(p))
     std = np.sqrt(sigma2 * np.sum(Rinv**2, axis=1))
     residual = rhs - columns @ x
-    return Fit(
+    fit = Fit(
         names=names,
         values=x,
         std=std,
         residual_rms=float(np.sqrt(np.mean(residual**2))),
         residual_rms_per_actuator=np.sqrt(np.mean(residual**2, axis=0)),
-        condition_number=cond,
+        condition_number=check.condition_number,
+        inflation=check.inflation,
         weights=w,
         samples=n,
         base=base,
@@ -601,3 +631,6 @@ def identify(
         identical_legs=identical_legs,
         backend=backend,
     )
+    if fit.condition_number > warn_condition:
+        warnings.warn(_inflated(fit, warn_condition), IdentificationWarning, stacklevel=2)
+    return fit

@@ -97,7 +97,8 @@ class Variant:
             ) from None
 
     def path(self, role: str) -> Path:
-        """Path of a generated file by role: ``numpy``, ``c_header`` or ``c_source``."""
+        """Path of a generated file by role: ``numpy``, ``c_header``, ``c_source``, ``c_cmake``
+        or ``c_pkgconfig``."""
         return self.folder / self.files[role]
 
 

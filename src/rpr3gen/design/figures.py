@@ -10,25 +10,28 @@ from __future__ import annotations
 
 import math
 import os
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any, Literal
 
 import numpy as np
-from matplotlib import patheffects
+from matplotlib import colormaps, patheffects
+from matplotlib.artist import Artist
 from matplotlib.axes import Axes
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.colors import ListedColormap, LogNorm
 from matplotlib.figure import Figure
 from matplotlib.image import AxesImage
 from matplotlib.lines import Line2D
+from matplotlib.patches import Patch
+from matplotlib.ticker import FuncFormatter
 
 from rpr3gen.atomic import atomic_write
 from rpr3gen.design.maps import WorkspaceMap
 from rpr3gen.model import LEGS
 from rpr3gen.plots import DPI
 
-__all__ = ["FIGSIZE", "FIGURES", "write_figures"]
+__all__ = ["CLIP_PERCENTILE", "FIGSIZE", "FIGURES", "OVER_COLOR", "write_figures"]
 
 FIGSIZE = (6.4, 6.4)
 """Figure size, inches."""
@@ -36,7 +39,12 @@ FIGSIZE = (6.4, 6.4)
 LEG_COLORS = {"A": "tab:blue", "B": "tab:orange", "C": "tab:green"}
 """Colour of each leg's pivot and stroke-limit curves."""
 
-_UNITS = {"m10": "N·m", "f21z": "N"}
+
+CLIP_PERCENTILE = 95.0
+"""The peak-effort map's colour scale ends at this percentile of the reachable points' efforts."""
+
+OVER_COLOR = "#33b5e5"
+"""Colour of the points above the peak-effort map's colour scale (not in its colour map)."""
 
 
 def _frame(wmap: WorkspaceMap, title: str) -> tuple[Figure, Axes]:
@@ -51,9 +59,22 @@ def _frame(wmap: WorkspaceMap, title: str) -> tuple[Figure, Axes]:
     return fig, ax
 
 
-def _legend(fig: Figure, handles: list[Line2D]) -> None:
+def _legend(fig: Figure, handles: Sequence[Artist], ncols: int = 3) -> None:
     """The legend below the map, where it hides nothing."""
-    fig.legend(handles=handles, loc="outside lower center", ncols=3, fontsize="small")
+    fig.legend(handles=handles, loc="outside lower center", ncols=ncols, fontsize="small")
+
+
+def _tick(value: float, _position: int | None = None) -> str:
+    """A log colour bar's tick label: the values 1, 2, 5 times a power of ten, in plain digits."""
+    if value <= 0:
+        return ""
+    digit = round(value / 10 ** math.floor(math.log10(value)), 6)
+    return _amount(value) if digit in (1, 2, 5) else ""
+
+
+def _amount(value: float) -> str:
+    """``24,658`` or ``835`` or ``0.0123``: three significant digits at least, no exponent."""
+    return f"{value:,.0f}" if value >= 100 else f"{value:.3g}"
 
 
 def _extent(wmap: WorkspaceMap) -> tuple[float, float, float, float]:
@@ -182,17 +203,45 @@ def conditioning_figure(wmap: WorkspaceMap) -> Figure:
 
 
 def effort_figure(wmap: WorkspaceMap) -> Figure:
-    """The largest static actuator effort of the three legs at each reachable point."""
+    """The largest static actuator effort of the three legs at each reachable point.
+
+    Loads grow as 1/conditioning towards a parallel singularity, so the few points just above
+    the conditioning floor reach efforts orders of magnitude above the rest (24,658 N·m on the
+    paper robot, 37 N·m at the median). The colour scale (log) ends at the
+    :data:`CLIP_PERCENTILE` th percentile of the reachable points' efforts; the points above it
+    are drawn in :data:`OVER_COLOR`, and the legend says where the scale ends and up to what
+    the points above it go.
+    """
     unit = wmap.effort_unit
     fig, ax = _frame(wmap, f"Peak static effort max |{wmap.effort}| over legs A, B, C")
     peak = np.max(np.abs(wmap.tau), axis=2)
     finite = peak[np.isfinite(peak) & (peak > 0)]
+    handles: list[Artist] = [*_outline(ax, wmap), *_pivots(ax, wmap)]
     if finite.size:
-        norm = LogNorm(vmin=float(finite.min()), vmax=float(finite.max()))
-        image = _image(ax, wmap, np.where(peak > 0, peak, np.nan), cmap="magma", norm=norm)
-        fig.colorbar(image, ax=ax, label=f"max |{wmap.effort}| [{unit}] (log scale)", shrink=0.8)
-    handles = _outline(ax, wmap) + _pivots(ax, wmap)
-    _legend(fig, handles)
+        low, high = float(finite.min()), float(finite.max())
+        top = float(np.percentile(finite, CLIP_PERCENTILE))
+        clipped = low < top < high
+        cmap = colormaps["magma"].with_extremes(over=OVER_COLOR)
+        norm = LogNorm(vmin=low, vmax=top if clipped else high)
+        image = _image(ax, wmap, np.where(peak > 0, peak, np.nan), cmap=cmap, norm=norm)
+        label = f"max |{wmap.effort}| [{unit}] (log scale"
+        label += f", to the {CLIP_PERCENTILE:g}th percentile)" if clipped else ")"
+        bar = fig.colorbar(
+            image, ax=ax, label=label, shrink=0.8, extend="max" if clipped else "neither"
+        )
+        plain = FuncFormatter(_tick)  # 20, 50, 100, 200 ..., not 2 x 10^1
+        bar.ax.yaxis.set_major_formatter(plain)
+        bar.ax.yaxis.set_minor_formatter(plain)
+        if clipped:
+            share = np.count_nonzero(finite > top) / finite.size
+            handles.append(
+                Patch(
+                    facecolor=OVER_COLOR,
+                    label=f"above the scale: {_amount(top)} to {_amount(high)} {unit} "
+                    f"({share:.1%} of the points)",
+                )
+            )
+    _legend(fig, handles, ncols=2)
     return fig
 
 

@@ -1,4 +1,5 @@
-"""The C99 backend: a header and a source per variant, needing only ``<math.h>``, ``<stddef.h>``.
+"""The C99 backend: a header and a source per variant, needing only ``<math.h>``, ``<stddef.h>``,
+and the files that make them a CMake and pkg-config package (:mod:`.package`).
 
 Per function ``f`` of a module with prefix ``p``: ``int p_f(params, inputs..., outputs...)`` for
 one sample (outputs untouched unless it returns ``P_OK``) and ``size_t p_f_batch(params, n,
@@ -15,6 +16,7 @@ from typing import TYPE_CHECKING, Any
 
 import jinja2
 from rpr3gen_derive.codegen import mathkernels
+from rpr3gen_derive.codegen.backends.c import package
 from rpr3gen_derive.codegen.backends.c.batch import NotSplittableError, plan
 from rpr3gen_derive.codegen.backends.c.order import Line, schedule
 from rpr3gen_derive.codegen.backends.c.printer import c_code, fast_trig_arguments
@@ -199,7 +201,8 @@ def render(
     env: jinja2.Environment,
     stage: Stage,
 ) -> dict[str, tuple[str, str]]:
-    """``{"c_header": (name, text), "c_source": (name, text)}`` of one module."""
+    """``{"c_header": (name, text), "c_source": (name, text), ...}`` of one module, with the
+    package files of :func:`.package.render` (``c_cmake``, ``c_pkgconfig``)."""
 
     with stage("print"):
         values = {name for c in compiled for name in c.spec.c_values}
@@ -229,10 +232,13 @@ def render(
     with stage("render"):
         header = env.get_template("backends/c/templates/header.h.jinja").render(context)
         source = env.get_template("backends/c/templates/source.c.jinja").render(context)
-    return {
-        "c_header": (f"{module.prefix}.h", header),
-        "c_source": (f"{module.prefix}.c", source),
-    }
+        files = {
+            "c_header": (f"{module.prefix}.h", header),
+            "c_source": (f"{module.prefix}.c", source),
+        }
+        names = {"header": files["c_header"][0], "source": files["c_source"][0]}
+        files.update(package.render(module, digest, env, **names))
+    return files
 
 
 __all__ = ["render"]
