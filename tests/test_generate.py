@@ -14,23 +14,26 @@ from typing import Any
 import pytest
 from rpr3gen_derive.codegen import files
 from rpr3gen_derive.planar import generate
+from rpr3gen_derive.planar.structures import Structure
 
 import rpr3gen
 from rpr3gen import manifest
 from rpr3gen.cli import main
 from rpr3gen.evaluators import numpy_module
 
-#: Renders of the sources in this process, by actuations: a full render takes seconds, and most
+#: Renders of the sources in this process, by structures: a full render takes seconds, and most
 #: tests below check what is done with its files, not the render again.
 _RENDERS: dict[tuple[str, ...], dict[str, str]] = {}
 _RENDER = generate.render
 
 
-def _rendered(actuations: Iterable[str] = generate.ACTUATIONS, **kwargs: Any) -> dict[str, str]:
-    """``generate.render``, done once per process for each set of actuations."""
+def _rendered(
+    structures: Iterable[Structure] = generate.COMMITTED, **kwargs: Any
+) -> dict[str, str]:
+    """``generate.render``, done once per process for each set of structures."""
     if kwargs:
-        return _RENDER(actuations, **kwargs)
-    key = tuple(actuations)
+        return _RENDER(structures, **kwargs)
+    key = tuple(structures)
     if key not in _RENDERS:
         _RENDERS[key] = _RENDER(key)
     return dict(_RENDERS[key])
@@ -48,8 +51,8 @@ def test_committed_generated_tree_is_current(
 ) -> None:
     """The check that every commit keeps, by a render of its own (kept for the other tests)."""
 
-    def render(actuations: Iterable[str] = generate.ACTUATIONS) -> dict[str, str]:
-        key = tuple(actuations)
+    def render(structures: Iterable[Structure] = generate.COMMITTED) -> dict[str, str]:
+        key = tuple(structures)
         text = _RENDER(key)
         if key in _RENDERS:  # a second render in this process writes the same files
             assert text == _RENDERS[key]
