@@ -164,7 +164,11 @@ COMMANDS: tuple[Command, ...] = (
     Command(
         "identify",
         lambda tmp: ["identify", "--data", data_csv(tmp)],
-        numbers={"--smoothing": SMOOTHING, "--max-condition": Numeric(least=1.0, finite=False)},
+        numbers={
+            "--smoothing": SMOOTHING,
+            "--warn-condition": Numeric(least=1.0, finite=False),
+            "--max-condition": Numeric(least=1.0, finite=False),
+        },
         outputs={"--out": False},
         inputs={"--model": "model", "--data": "data"},
     ),
