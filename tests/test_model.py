@@ -229,6 +229,11 @@ def test_model_constructor_checks_its_fields() -> None:
         Model(name="x", actuation="hydraulic", params=params, source="s")
     with pytest.raises(ModelError, match="J3"):
         Model(name="x", actuation="revolute", params={**params, "J3x": 1.0}, source="s")
+    with pytest.raises(ModelError, match=r"params\['m3'\]: must be a finite number"):
+        Model(name="x", actuation="revolute", params={**params, "m3": 10**400}, source="s")
+    with pytest.raises(ModelError, match=r"stroke\[1\]: must be a finite number"):
+        Model(name="x", actuation="revolute", params=params, source="s",
+              stroke=((0.0, 0.1), (0.0, 10**400), (0.0, 0.1)))  # fmt: skip
     reordered = Model(
         name="x", actuation="revolute", params=dict(reversed(params.items())), source="s"
     )
@@ -261,6 +266,10 @@ BAD_FILES: list[tuple[str, str, tuple[str, ...]]] = [
     ("c2-nan", PAPER.replace("m3 = 5.0", "m3 = 5.0\nc2 = nan"), ("mass.c2", "finite")),
     ("l0-nan", PAPER.replace("l0 = 0.1", "l0 = nan"), ("geometry.l0", "finite", "nan")),
     ("m1-inf", PAPER.replace("m1 = 3.0", "m1 = inf"), ("mass.m1", "finite", "inf")),
+    ("m1-beyond-float64", PAPER.replace("m1 = 3.0", "m1 = 1" + "0" * 400),
+     ("mass.m1", "finite", "an integer of 401 digits")),
+    ("l0-beyond-float64", PAPER.replace("l0 = 0.1", "l0 = -1" + "0" * 310),
+     ("geometry.l0", "finite", "an integer of 311 digits")),
     ("beta-inf", PAPER.replace("beta_deg = 30.0", "beta_deg = -inf"), ("geometry.beta_deg",)),
     ("alpha-short", PAPER.replace("[90.0, -150.0, -30.0]", "[90.0, -150.0]"),
      ("geometry.alpha_deg", "list of 3 numbers", "list of 2 items")),

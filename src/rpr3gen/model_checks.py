@@ -68,7 +68,10 @@ def check_fields(model: Any, actuations: Sequence[str]) -> dict:
 def _number(value: Any, where: str) -> float:
     if isinstance(value, bool | np.bool_) or not isinstance(value, Real):
         raise InputTypeError(f"{where}: must be a number, got {describe(value)}")
-    number = float(value)
+    try:
+        number = float(value)
+    except OverflowError:  # an integer beyond float64
+        raise ModelError(f"{where}: must be a finite number, got {describe(value)}") from None
     if not math.isfinite(number):
         raise ModelError(f"{where}: must be a finite number, got {number!r}")
     return number
