@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
 import pickle
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -239,6 +241,34 @@ def test_model_constructor_checks_its_fields() -> None:
     )
     assert tuple(reordered.params) == PARAM_NAMES
     assert ACTUATIONS == ("revolute", "prismatic")
+
+
+def test_model_constructor_checks_a_general_models_limits() -> None:
+    """``limits`` (the general format's ``[limits]``) is checked like every field: a wrong type
+    is an InputTypeError, a bad key or pair a ModelError naming it; never a traceback later."""
+    model = load_model(REPO / "models" / "prr.toml")
+    assert dict(model.limits) == {f"{leg}.q1": (-0.25, 0.25) for leg in "ABC"}
+    again = dataclasses.replace(model, limits={"B.q2": [-1, 1]})
+    assert dict(again.limits) == {"B.q2": (-1.0, 1.0)}
+    with pytest.raises(InputTypeError, match="limits: must be a mapping"):
+        dataclasses.replace(model, limits=[("A.q1", (0.0, 1.0))])
+    for key, words in (("A.q4", "unknown joint coordinate; did you mean 'A.q3'?"),
+                       ("q1", "unknown joint coordinate")):  # fmt: skip
+        with pytest.raises(ModelError, match=re.escape(f"limits[{key!r}]: {words}")):
+            dataclasses.replace(model, limits={key: (0.0, 1.0)})
+    for pair, words in (
+        ((1.0, 0.0), "the lower bound must be below the upper"),
+        ((0.0, math.nan), "must be a finite number"),
+        ((0.0, 10**400), "must be a finite number"),
+        ((0.0,), "must be a pair (lo, hi)"),
+        ("01", "must be a pair (lo, hi)"),
+    ):
+        with pytest.raises(ModelError, match=re.escape(f"limits['A.q1']: {words}")):
+            dataclasses.replace(model, limits={"A.q1": pair})
+    with pytest.raises(InputTypeError, match=re.escape("limits['A.q1']: must be a number")):
+        dataclasses.replace(model, limits={"A.q1": ("lo", 1.0)})
+    with pytest.raises(ModelError, match="bounds its pistons with stroke"):
+        dataclasses.replace(load_model(), limits={"A.q1": (0.0, 1.0)})
 
 
 def test_errors_are_rpr3gen_errors() -> None:

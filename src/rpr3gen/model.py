@@ -146,8 +146,8 @@ class Model:
         object.__setattr__(self, "params", _ReadOnlyParams(fields["params"]))
         object.__setattr__(self, "stroke", fields["stroke"])
         object.__setattr__(self, "generated", fields["generated"])
-        if self.limits is not None:
-            object.__setattr__(self, "limits", _ReadOnlyLimits(self.limits))
+        if fields["limits"] is not None:
+            object.__setattr__(self, "limits", _ReadOnlyLimits(fields["limits"]))
 
     @property
     def variant(self) -> str:
