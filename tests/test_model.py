@@ -250,6 +250,9 @@ def test_model_constructor_checks_a_general_models_limits() -> None:
     assert dict(model.limits) == {f"{leg}.q1": (-0.25, 0.25) for leg in "ABC"}
     again = dataclasses.replace(model, limits={"B.q2": [-1, 1]})
     assert dict(again.limits) == {"B.q2": (-1.0, 1.0)}
+    with pytest.raises(ModelError, match=r"params: missing \['xA1', .* and 19 more, .*"
+                       "structure=None means the paper's format"):  # fmt: skip
+        dataclasses.replace(model, structure=None)
     with pytest.raises(InputTypeError, match="limits: must be a mapping"):
         dataclasses.replace(model, limits=[("A.q1", (0.0, 1.0))])
     for key, words in (("A.q4", "unknown joint coordinate; did you mean 'A.q3'?"),

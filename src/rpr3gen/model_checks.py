@@ -54,7 +54,9 @@ def check_fields(model: Any, actuations: Sequence[str]) -> dict:
             f"{describe(model.actuation)}"
         )
     param_names = structure.param_names()
-    params = _params(model.params, source, param_names)
+    # Built by hand without a structure, a general model's params are not the paper's.
+    hint = "; structure=None means the paper's format" if model.structure is None else ""
+    params = _params(model.params, source, param_names, hint)
     stroke = None if model.stroke is None else _stroke(model.stroke, source)
     limits = None if model.limits is None else _limits(model.limits, source, structure)
     generated = None
@@ -84,15 +86,24 @@ def _number(value: Any, where: str) -> float:
     return number
 
 
-def _params(params: Any, source: str, names: Sequence[str]) -> dict[str, float]:
+def _params(params: Any, source: str, names: Sequence[str], hint: str = "") -> dict[str, float]:
     if not isinstance(params, Mapping):
         raise InputTypeError(f"{source}: params: must be a mapping name -> number, got "
                              f"{describe(params)}")  # fmt: skip
     if set(params) != set(names):
         missing = [n for n in names if n not in params]
         extra = sorted(map(str, set(params) - set(names)))
-        raise ModelError(f"{source}: params: missing {missing}, unexpected {extra}")
+        raise ModelError(
+            f"{source}: params: missing {_some(missing)}, unexpected {_some(extra)}{hint}"
+        )
     return {n: _number(params[n], f"{source}: params[{n!r}]") for n in names}
+
+
+def _some(names: Sequence[str], shown: int = 6) -> str:
+    """A list of names for a message: the first few, and how many more."""
+    if len(names) <= shown:
+        return repr(list(names))
+    return f"{list(names[:shown])!r} and {len(names) - shown} more"
 
 
 def _stroke(stroke: Any, source: str) -> tuple[tuple[float, float], ...]:
