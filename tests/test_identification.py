@@ -414,6 +414,63 @@ def test_bad_samples_are_named() -> None:
         rpr3gen.identify(model, q[:5], qd[:5], qdd[:5], tau[:5])
 
 
+def _gallery_rrr(shared_offsets: bool) -> Model:
+    """``models/rrr.toml`` with legs B and C written out: leg A turned by 120 and 240 degrees,
+    and with ``shared_offsets`` their centres of mass moved so that each sits where leg A's
+    does from its first joint point (world axes): then the legs' inertial parameters agree."""
+    root = Path(__file__).resolve().parent.parent
+    with (root / "models" / "rrr.toml").open("rb") as handle:
+        data = tomllib.load(handle)
+    del data["symmetric"]
+    a = data["legs"]["A"]
+    for k, leg in ((1, "B"), (2, "C")):
+        c, s = math.cos(2 * math.pi * k / 3), math.sin(2 * math.pi * k / 3)
+        turn = np.array([[c, -s], [s, c]])
+        joints = np.array(a["joints"]) @ turn.T
+        com = np.array(a["com"]) @ turn.T
+        if shared_offsets:
+            com = joints[:2] + (np.array(a["com"]) - np.array(a["joints"])[:2])
+        data["legs"][leg] = {**a, "joints": joints.tolist(), "com": com.tolist()}
+    return rpr3gen.model_from_dict(data, source="rrr")
+
+
+def test_identical_legs_is_refused_where_the_legs_differ() -> None:
+    """A general model's legs turned by 120 degrees have other first moments in the world's
+    axes: every function that would share the legs' parameters refuses (docs/interfaces.md),
+    rather than fit or predict with a robot that is not the model's."""
+    model = _gallery_rrr(shared_offsets=False)
+    traj = rpr3gen.read_trajectory_csv(Path(__file__).resolve().parent.parent / "models/loop.csv")
+    q, qd, qdd = traj.q[::10], traj.qd[::10], traj.qdd[::10]
+    tau = rpr3gen.actuator_efforts(model, q, qd, qdd)
+    calls = {
+        "inertial_parameters": lambda: rpr3gen.inertial_parameters(model, identical_legs=True),
+        "regressor": lambda: rpr3gen.regressor(model, q, qd, qdd, identical_legs=True),
+        "base_regressor": lambda: rpr3gen.base_regressor(model, q, qd, qdd, identical_legs=True),
+        "base_parameters": lambda: rpr3gen.base_parameters(model, identical_legs=True),
+        "identify": lambda: rpr3gen.identify(
+            model, q, qd, qdd, tau, identical_legs=True, max_condition=math.inf
+        ),
+        "excite": lambda: rpr3gen.excite(model, harmonics=1, samples=10, identical_legs=True),
+    }
+    for name, call in calls.items():
+        with pytest.raises(rpr3gen.InputError, match=r"^identical_legs: leg B's .* differ") as info:
+            call()
+        assert info.value.argument == "identical_legs", name
+
+
+def test_identical_legs_is_taken_where_the_legs_agree() -> None:
+    """Legs of other geometry but equal inertial parameters (world axes) share them: the summed
+    columns times the shared parameters are the model's efforts."""
+    model = _gallery_rrr(shared_offsets=True)
+    traj = rpr3gen.read_trajectory_csv(Path(__file__).resolve().parent.parent / "models/loop.csv")
+    q, qd, qdd = traj.q[::10], traj.qd[::10], traj.qdd[::10]
+    shared = rpr3gen.regressor(model, q, qd, qdd, identical_legs=True)
+    pi = rpr3gen.inertial_parameters(model, identical_legs=True)
+    tau = shared @ pi + rpr3gen.payload_efforts(model, q)
+    assert _relative(tau, rpr3gen.actuator_efforts(model, q, qd, qdd)) < 1e-12
+    assert len(rpr3gen.base_parameters(model, identical_legs=True).names) > 0
+
+
 # ----------------------------------------------------------------------------------------------
 # Exciting trajectories.
 

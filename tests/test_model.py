@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
 import pickle
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -229,11 +231,47 @@ def test_model_constructor_checks_its_fields() -> None:
         Model(name="x", actuation="hydraulic", params=params, source="s")
     with pytest.raises(ModelError, match="J3"):
         Model(name="x", actuation="revolute", params={**params, "J3x": 1.0}, source="s")
+    with pytest.raises(ModelError, match=r"params\['m3'\]: must be a finite number"):
+        Model(name="x", actuation="revolute", params={**params, "m3": 10**400}, source="s")
+    with pytest.raises(ModelError, match=r"stroke\[1\]: must be a finite number"):
+        Model(name="x", actuation="revolute", params=params, source="s",
+              stroke=((0.0, 0.1), (0.0, 10**400), (0.0, 0.1)))  # fmt: skip
     reordered = Model(
         name="x", actuation="revolute", params=dict(reversed(params.items())), source="s"
     )
     assert tuple(reordered.params) == PARAM_NAMES
     assert ACTUATIONS == ("revolute", "prismatic")
+
+
+def test_model_constructor_checks_a_general_models_limits() -> None:
+    """``limits`` (the general format's ``[limits]``) is checked like every field: a wrong type
+    is an InputTypeError, a bad key or pair a ModelError naming it; never a traceback later."""
+    model = load_model(REPO / "models" / "prr.toml")
+    assert dict(model.limits) == {f"{leg}.q1": (-0.25, 0.25) for leg in "ABC"}
+    again = dataclasses.replace(model, limits={"B.q2": [-1, 1]})
+    assert dict(again.limits) == {"B.q2": (-1.0, 1.0)}
+    with pytest.raises(ModelError, match=r"params: missing \['xA1', .* and 19 more, .*"
+                       "structure=None means the paper's format"):  # fmt: skip
+        dataclasses.replace(model, structure=None)
+    with pytest.raises(InputTypeError, match="limits: must be a mapping"):
+        dataclasses.replace(model, limits=[("A.q1", (0.0, 1.0))])
+    for key, words in (("A.q4", "unknown joint coordinate; did you mean 'A.q3'?"),
+                       ("q1", "unknown joint coordinate")):  # fmt: skip
+        with pytest.raises(ModelError, match=re.escape(f"limits[{key!r}]: {words}")):
+            dataclasses.replace(model, limits={key: (0.0, 1.0)})
+    for pair, words in (
+        ((1.0, 0.0), "the lower bound must be below the upper"),
+        ((0.0, math.nan), "must be a finite number"),
+        ((0.0, 10**400), "must be a finite number"),
+        ((0.0,), "must be a pair (lo, hi)"),
+        ("01", "must be a pair (lo, hi)"),
+    ):
+        with pytest.raises(ModelError, match=re.escape(f"limits['A.q1']: {words}")):
+            dataclasses.replace(model, limits={"A.q1": pair})
+    with pytest.raises(InputTypeError, match=re.escape("limits['A.q1']: must be a number")):
+        dataclasses.replace(model, limits={"A.q1": ("lo", 1.0)})
+    with pytest.raises(ModelError, match="bounds its pistons with stroke"):
+        dataclasses.replace(load_model(), limits={"A.q1": (0.0, 1.0)})
 
 
 def test_errors_are_rpr3gen_errors() -> None:
@@ -261,6 +299,10 @@ BAD_FILES: list[tuple[str, str, tuple[str, ...]]] = [
     ("c2-nan", PAPER.replace("m3 = 5.0", "m3 = 5.0\nc2 = nan"), ("mass.c2", "finite")),
     ("l0-nan", PAPER.replace("l0 = 0.1", "l0 = nan"), ("geometry.l0", "finite", "nan")),
     ("m1-inf", PAPER.replace("m1 = 3.0", "m1 = inf"), ("mass.m1", "finite", "inf")),
+    ("m1-beyond-float64", PAPER.replace("m1 = 3.0", "m1 = 1" + "0" * 400),
+     ("mass.m1", "finite", "an integer of 401 digits")),
+    ("l0-beyond-float64", PAPER.replace("l0 = 0.1", "l0 = -1" + "0" * 310),
+     ("geometry.l0", "finite", "an integer of 311 digits")),
     ("beta-inf", PAPER.replace("beta_deg = 30.0", "beta_deg = -inf"), ("geometry.beta_deg",)),
     ("alpha-short", PAPER.replace("[90.0, -150.0, -30.0]", "[90.0, -150.0]"),
      ("geometry.alpha_deg", "list of 3 numbers", "list of 2 items")),

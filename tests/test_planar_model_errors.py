@@ -185,6 +185,16 @@ CASES: dict[str, tuple[dict, str, tuple[str, ...]]] = {
         "limits.D.q1",
         ("unknown key",),
     ),
+    "a number beyond float64": (
+        _edit(RRR, platform__mass=10**400),
+        "platform.mass",
+        ("must be a finite number", "an integer of 401 digits"),
+    ),
+    "a bound beyond float64": (
+        _edit(RRR, limits={"q2": [-(10**309), 0.5]}),
+        "limits.q2[0]",
+        ("must be a finite number",),
+    ),
     "limits: bounds the wrong way": (
         _edit(RRR, limits={"q2": [0.5, -0.5]}),
         "limits.q2",
@@ -214,6 +224,37 @@ def test_one_line_naming_the_file_and_the_key(case: str, tmp_path: Path) -> None
     assert message.startswith(f"{path}: {key}: "), message
     for word in words:
         assert word in message, message
+
+
+def _in_unit(unit: float) -> dict:
+    """The 3-RRR with every length times ``unit``."""
+    scaled = copy.deepcopy(RRR)
+    leg = scaled["legs"]["A"]
+    leg["joints"] = [[v * unit for v in p] for p in leg["joints"]]
+    leg["com"] = [[v * unit for v in p] for p in leg["com"]]
+    return scaled
+
+
+def test_a_model_in_a_huge_unit_reads_as_the_same_robot(tmp_path: Path) -> None:
+    """The home checks are dimensionless: the 3-RRR with every length times 2^500 is read
+    without overflow (a warning is an error here) and keeps its working modes."""
+    paths = []
+    for name, data in (("plain", RRR), ("huge", _in_unit(2.0**500))):
+        paths.append(tmp_path / f"{name}.toml")
+        paths[-1].write_text(_toml(data))
+    plain, huge = (rpr3gen.load_model(p) for p in paths)
+    for leg in "ABC":
+        assert huge.params[f"sigma_{leg}"] == plain.params[f"sigma_{leg}"]
+        assert huge.params[f"x3_{leg}"] == plain.params[f"x3_{leg}"] * 2.0**500
+
+
+def test_a_model_in_a_tiny_unit_is_refused_for_what_it_is(tmp_path: Path) -> None:
+    """Times 2^-500 the legs are no serial singularity (no underflow to 0 / 0): their platform
+    joints are closer than the 1e-9 m in which points coincide, and the message says so."""
+    path = tmp_path / "tiny.toml"
+    path.write_text(_toml(_in_unit(2.0**-500)))
+    with pytest.raises(rpr3gen.ModelError, match=r"legs\.B\.joints: legs A and B meet the"):
+        rpr3gen.load_model(path)
 
 
 @pytest.mark.parametrize(

@@ -126,9 +126,10 @@ class GeneralReader(_Reader):
         legs = self.legs(legs_table, structure, symmetric)
         platform = self.platform(self.table(data, "platform", required=True))
         params: dict[str, float] = {}
+        unit = _unit_scaled(legs)  # the home checks' arithmetic, free of overflow
         for leg in LEGS:
-            self.leg_params(structure, leg, legs[leg], params)
-        self.check_home(structure, legs)
+            self.leg_params(structure, leg, legs[leg], params, unit[leg]["joints"])
+        self.check_home(structure, legs, unit)
         params["m3"], params["J3"] = platform["mass"], platform["inertia"]
         params["cx3"], params["cy3"] = platform["com"]
         environment = self.table(data, "environment", required=False)
@@ -247,13 +248,22 @@ class GeneralReader(_Reader):
         return {"mass": mass, "inertia": inertia, "com": com}
 
     def leg_params(
-        self, structure: Structure, leg: str, data: Mapping[str, np.ndarray], params: dict
+        self,
+        structure: Structure,
+        leg: str,
+        data: Mapping[str, np.ndarray],
+        params: dict,
+        unit_joints: np.ndarray,
     ) -> None:
+        """The leg's parameters into ``params``, after its check at home, which is computed
+        from ``unit_joints`` (its joints in the unit of :func:`_unit_scaled`: the normalised
+        determinant and its sign do not depend on the unit)."""
         joints, axes = data["joints"], data["axes"]
         for j in range(3):
             params[f"x{j + 1}_{leg}"], params[f"y{j + 1}_{leg}"] = (float(v) for v in joints[j])
             if structure.leg[j] == "P":
                 params[f"ux{j + 1}_{leg}"], params[f"uy{j + 1}_{leg}"] = (float(v) for v in axes[j])
+        joints = unit_joints
         S = serial_columns(structure.leg, joints, axes)
         scale = max(np.linalg.norm(joints[2]), *(np.linalg.norm(joints[2] - p) for p in joints))
         scaled = S * np.array([[1.0], [1.0], [scale]])
@@ -274,8 +284,13 @@ class GeneralReader(_Reader):
             )
 
     def check_home(
-        self, structure: Structure, legs: Mapping[str, Mapping[str, np.ndarray]]
+        self,
+        structure: Structure,
+        legs: Mapping[str, Mapping[str, np.ndarray]],
+        unit: Mapping[str, Mapping[str, np.ndarray]],
     ) -> None:
+        """The three legs at home: their platform joints apart (``legs``), and holding the
+        platform (computed from ``unit``, the legs in the unit of :func:`_unit_scaled`)."""
         for i in range(3):
             for j in range(i + 1, 3):
                 a, b = (legs[LEGS[k]]["joints"][2] for k in (i, j))
@@ -285,7 +300,7 @@ class GeneralReader(_Reader):
                         f"legs {LEGS[i]} and {LEGS[j]} meet the platform at one point "
                         f"({a[0]:.6g}, {a[1]:.6g}): the platform could turn about it",
                     )
-        conditioning = home_conditioning(structure, legs)
+        conditioning = home_conditioning(structure, unit)
         if not conditioning > PARALLEL_HOME_TOL:
             self.fail(
                 "legs",
@@ -318,6 +333,19 @@ class GeneralReader(_Reader):
             for leg in legs:
                 out[f"{leg}.{key.split('.')[-1]}"] = (lo, hi)
         return dict(sorted(out.items()))
+
+
+def _unit_scaled(
+    legs: Mapping[str, Mapping[str, np.ndarray]],
+) -> dict[str, dict[str, np.ndarray]]:
+    """The legs with their joints in a unit of length, a power of two, in which the largest
+    coordinate is in ``[0.5, 1)``: the home checks square and multiply coordinates, which
+    overflow (or underflow to zero) for finite but huge (or tiny) numbers in a model file,
+    while their measures are dimensionless. Exact (powers of two) but where a coordinate
+    smaller than ``2**-1022`` of the largest becomes subnormal."""
+    largest = max(float(np.abs(legs[leg]["joints"]).max()) for leg in LEGS)
+    factor = math.ldexp(1.0, -math.frexp(largest)[1]) if largest > 0.0 else 1.0
+    return {leg: {**legs[leg], "joints": legs[leg]["joints"] * factor} for leg in LEGS}
 
 
 def _turned(leg: Mapping[str, np.ndarray], degrees: float) -> dict[str, np.ndarray]:

@@ -142,26 +142,49 @@ def inertial_parameters(model: Model, identical_legs: bool = False) -> np.ndarra
         platform = [p["m3"], 0.0, 0.0, p["J3"]]
         legs = 1 if identical_legs else len(LEGS)
         return np.array((cylinder + piston) * legs + platform, dtype=float)
+    per_leg = _general_legs(model)
+    platform = body(p["m3"], p["cx3"], p["cy3"], p["J3"])
+    if identical_legs:
+        _check_identical_legs(model)
+        return np.array(per_leg[0] + platform, dtype=float)
+    return np.array([v for values in per_leg for v in values] + platform, dtype=float)
+
+
+def _general_legs(model: Model) -> list[list[float]]:
+    """A general model's inertial parameters of legs A, B, C (8 each: bodies 1 and 2)."""
+    p = model.params
     per_leg = []
     for leg in LEGS:
         values = []
         for k in (1, 2):
             dx = p[f"cx{k}_{leg}"] - p[f"x{k}_{leg}"]
             dy = p[f"cy{k}_{leg}"] - p[f"y{k}_{leg}"]
-            values += body(p[f"m{k}_{leg}"], dx, dy, p[f"J{k}_{leg}"])
+            m, j = p[f"m{k}_{leg}"], p[f"J{k}_{leg}"]
+            values += [m, m * dx, m * dy, j + m * (dx**2 + dy**2)]
         per_leg.append(values)
-    platform = body(p["m3"], p["cx3"], p["cy3"], p["J3"])
-    if identical_legs:
-        first = np.array(per_leg[0])
-        for leg, values in zip(LEGS[1:], per_leg[1:], strict=True):
-            if not np.allclose(values, first, rtol=1e-12, atol=1e-15):
-                raise InputError(
-                    f"identical_legs: leg {leg}'s inertial parameters differ from leg A's "
-                    "(the general format's first moments are in the world's axes, so legs "
-                    "turned by 120 degrees differ); identify per leg"
-                )
-        return np.array(per_leg[0] + platform, dtype=float)
-    return np.array([v for values in per_leg for v in values] + platform, dtype=float)
+    return per_leg
+
+
+def _check_identical_legs(model: Model) -> None:
+    """Refuse ``identical_legs`` for a general model whose legs' inertial parameters differ:
+    sharing them would fit, and predict with, a robot that is not this one (docs/interfaces.md,
+    "Any planar 3-leg robot"). The paper's format describes one leg for all three.
+
+    Raises:
+        InputError: naming ``identical_legs`` and the first leg that differs from leg A.
+    """
+    if model.structure.paper:
+        return
+    per_leg = _general_legs(model)
+    first = np.array(per_leg[0])
+    for leg, values in zip(LEGS[1:], per_leg[1:], strict=True):
+        if not np.allclose(values, first, rtol=1e-12, atol=1e-15):
+            raise InputError(
+                f"identical_legs: leg {leg}'s inertial parameters differ from leg A's "
+                "(the general format's first moments are in the world's axes, so legs "
+                "turned by 120 degrees differ); identify per leg",
+                argument="identical_legs",
+            )
 
 
 def _check_names(model: Model) -> None:
@@ -196,7 +219,12 @@ def regressor(
 
     Rows: the efforts of legs A, B, C (``m10_*`` or ``f21z_*``); columns: :func:`parameter_names`.
     A singular pose gives a NaN row, as :func:`rpr3gen.inverse_dynamics` refuses it.
+
+    Raises:
+        InputError: ``identical_legs`` with a general model whose legs' parameters differ.
     """
+    if identical_legs:
+        _check_identical_legs(model)
     Y, _ = _regressor_and_codes(model, q, qd, qdd, backend)
     return Y @ shared_matrix() if identical_legs else Y
 
@@ -327,7 +355,13 @@ def base_parameters(model: Model, identical_legs: bool = False) -> BaseParameter
     The regroupings this finds are stated in closed form in docs/identification.md (and
     tested equal). The matrix depends on the geometry (l2, the platform joints), not on the
     masses.
+
+    Raises:
+        InputError: ``identical_legs`` with a general model whose legs' parameters differ
+            (so also :func:`base_regressor`, :func:`identify` and :func:`rpr3gen.excite`).
     """
+    if identical_legs:
+        _check_identical_legs(model)
     return _base_parameters(model, bool(identical_legs))
 
 

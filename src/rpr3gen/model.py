@@ -146,8 +146,8 @@ class Model:
         object.__setattr__(self, "params", _ReadOnlyParams(fields["params"]))
         object.__setattr__(self, "stroke", fields["stroke"])
         object.__setattr__(self, "generated", fields["generated"])
-        if self.limits is not None:
-            object.__setattr__(self, "limits", _ReadOnlyLimits(self.limits))
+        if fields["limits"] is not None:
+            object.__setattr__(self, "limits", _ReadOnlyLimits(fields["limits"]))
 
     @property
     def variant(self) -> str:
@@ -391,7 +391,10 @@ class _Reader:
         kind = "a positive number" if positive else "a number"
         if isinstance(value, bool | np.bool_) or not isinstance(value, Real):
             self.fail(dotted, f"must be {kind}, got {_describe(value)}")
-        x = float(value)
+        try:
+            x = float(value)
+        except OverflowError:  # an integer beyond float64 (TOML integers have no bound)
+            self.fail(dotted, f"must be a finite number, got {_describe(value)}")
         if not math.isfinite(x):
             self.fail(dotted, f"must be a finite number, got {_describe(value)}")
         if positive and x <= 0.0:
@@ -554,9 +557,20 @@ def _describe(value: Any) -> str:
     if isinstance(value, list | tuple | np.ndarray):
         n = len(value)
         return f"a list of {n} item{'s' if n != 1 else ''}"
+    if isinstance(value, int | np.integer):
+        return _integer(int(value))
     if isinstance(value, Real):
-        return repr(int(value)) if isinstance(value, int | np.integer) else repr(float(value))
+        return repr(float(value))
     return f"a value of type {type(value).__name__}"
+
+
+def _integer(value: int) -> str:
+    """An integer as written, or its first digits and its size when it is too long to show
+    (TOML integers have no bound: ``10**400`` is a valid one)."""
+    text = repr(value)
+    if len(text) <= 24:
+        return text
+    return f"{text[:12]}... (an integer of {len(text.lstrip('-'))} digits)"
 
 
 def _quoted(words: Sequence[str]) -> str:

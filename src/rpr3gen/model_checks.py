@@ -17,8 +17,8 @@ from typing import Any
 
 import numpy as np
 
-from rpr3gen.errors import InputTypeError, ModelError
-from rpr3gen.structure import Structure
+from rpr3gen.errors import InputTypeError, ModelError, did_you_mean
+from rpr3gen.structure import LEGS, Structure
 from rpr3gen.validation import PathArg, describe
 
 __all__ = ["check_fields"]
@@ -27,8 +27,8 @@ __all__ = ["check_fields"]
 def check_fields(model: Any, actuations: Sequence[str]) -> dict:
     """The fields of ``model`` checked and converted: its ``structure`` (the paper's of its
     ``actuation`` when it has none or a paper one), ``params`` as floats in the order of the
-    structure's parameter names, ``stroke`` as float pairs, ``generated`` as a checked folder
-    name."""
+    structure's parameter names, ``stroke`` as float pairs, ``limits`` as float pairs by joint
+    coordinate (``"A.q2"``), ``generated`` as a checked folder name."""
     source = model.source if isinstance(model.source, str) else "<model>"
     if not isinstance(model.source, str):
         raise InputTypeError(f"source: must be a str, got {describe(model.source)}")
@@ -54,35 +54,56 @@ def check_fields(model: Any, actuations: Sequence[str]) -> dict:
             f"{describe(model.actuation)}"
         )
     param_names = structure.param_names()
-    params = _params(model.params, source, param_names)
+    # Built by hand without a structure, a general model's params are not the paper's.
+    hint = "; structure=None means the paper's format" if model.structure is None else ""
+    params = _params(model.params, source, param_names, hint)
     stroke = None if model.stroke is None else _stroke(model.stroke, source)
+    limits = None if model.limits is None else _limits(model.limits, source, structure)
     generated = None
     if model.generated is not None:
         from rpr3gen.loader import check_folder
 
         generated = PathArg()("generated", model.generated)
         check_folder(structure.variant, generated, tuple(param_names))
-    return {"structure": structure, "params": params, "stroke": stroke, "generated": generated}
+    return {
+        "structure": structure,
+        "params": params,
+        "stroke": stroke,
+        "limits": limits,
+        "generated": generated,
+    }
 
 
 def _number(value: Any, where: str) -> float:
     if isinstance(value, bool | np.bool_) or not isinstance(value, Real):
         raise InputTypeError(f"{where}: must be a number, got {describe(value)}")
-    number = float(value)
+    try:
+        number = float(value)
+    except OverflowError:  # an integer beyond float64
+        raise ModelError(f"{where}: must be a finite number, got {describe(value)}") from None
     if not math.isfinite(number):
         raise ModelError(f"{where}: must be a finite number, got {number!r}")
     return number
 
 
-def _params(params: Any, source: str, names: Sequence[str]) -> dict[str, float]:
+def _params(params: Any, source: str, names: Sequence[str], hint: str = "") -> dict[str, float]:
     if not isinstance(params, Mapping):
         raise InputTypeError(f"{source}: params: must be a mapping name -> number, got "
                              f"{describe(params)}")  # fmt: skip
     if set(params) != set(names):
         missing = [n for n in names if n not in params]
         extra = sorted(map(str, set(params) - set(names)))
-        raise ModelError(f"{source}: params: missing {missing}, unexpected {extra}")
+        raise ModelError(
+            f"{source}: params: missing {_some(missing)}, unexpected {_some(extra)}{hint}"
+        )
     return {n: _number(params[n], f"{source}: params[{n!r}]") for n in names}
+
+
+def _some(names: Sequence[str], shown: int = 6) -> str:
+    """A list of names for a message: the first few, and how many more."""
+    if len(names) <= shown:
+        return repr(list(names))
+    return f"{list(names[:shown])!r} and {len(names) - shown} more"
 
 
 def _stroke(stroke: Any, source: str) -> tuple[tuple[float, float], ...]:
@@ -102,3 +123,31 @@ def _stroke(stroke: Any, source: str) -> tuple[tuple[float, float], ...]:
                              f"got ({lo_:g}, {hi_:g})")  # fmt: skip
         out.append((lo_, hi_))
     return tuple(out)
+
+
+def _limits(limits: Any, source: str, structure: Structure) -> dict[str, tuple[float, float]]:
+    """The general format's joint-coordinate bounds ``{"A.q2": (lo, hi), ...}`` (the paper's
+    bounds its pistons with ``stroke``, not these)."""
+    shape = 'a mapping "A.q2" -> (lo, hi) of joint coordinates (m or rad)'
+    if not isinstance(limits, Mapping):
+        raise InputTypeError(f"{source}: limits: must be {shape}, got {describe(limits)}")
+    if structure.paper and limits:
+        raise ModelError(
+            f"{source}: limits: the paper's format bounds its pistons with stroke, not limits"
+        )
+    names = [f"{leg}.q{j}" for leg in LEGS for j in (1, 2, 3)]
+    out = {}
+    for key, pair in limits.items():
+        if key not in names:
+            hint = did_you_mean(str(key), names)
+            raise ModelError(f"{source}: limits[{key!r}]: unknown joint coordinate{hint} "
+                             '("A.q1" to "C.q3")')  # fmt: skip
+        where = f"{source}: limits[{key!r}]"
+        if isinstance(pair, str) or not isinstance(pair, Sequence | np.ndarray) or len(pair) != 2:
+            raise ModelError(f"{where}: must be a pair (lo, hi), got {describe(pair)}")
+        lo, hi = (_number(v, where) for v in pair)
+        if not lo < hi:
+            raise ModelError(f"{where}: the lower bound must be below the upper, "
+                             f"got ({lo:g}, {hi:g})")  # fmt: skip
+        out[key] = (lo, hi)
+    return out

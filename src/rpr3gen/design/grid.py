@@ -379,9 +379,13 @@ def _range(key: str, given: Mapping[str, Any], source: str) -> tuple[float, ...]
 def _number(where: str, value: Any, source: str) -> float:
     if isinstance(value, bool) or not isinstance(value, int | float):
         raise GridError(f"{source}: {where}: must be a number, got {_show(value)}")
-    if not math.isfinite(value):
+    try:
+        number = float(value)
+    except OverflowError:  # a TOML integer beyond float64
+        number = math.inf
+    if not math.isfinite(number):
         raise GridError(f"{source}: {where}: must be a finite number, got {_show(value)}")
-    return float(value)
+    return number
 
 
 def _show(value: Any) -> str:
@@ -393,7 +397,8 @@ def _show(value: Any) -> str:
         return "a table"
     if isinstance(value, list):
         return f"a list of {len(value)}"
-    return repr(value)
+    text = repr(value)  # a TOML integer may have hundreds of digits
+    return text if len(text) <= 40 else f"{text[:37]}..."
 
 
 def _path(name: str) -> list[str]:
