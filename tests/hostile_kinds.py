@@ -339,6 +339,8 @@ class Api:
         same_length: groups of array arguments that must have as many rows.
         nan_rows: arrays with a NaN row give a NaN row (else they are refused).
         costly: a call that succeeds takes long (Hypothesis then draws only refused values).
+        scene_free: takes no model: runs once (on the paper's scene of the API battery), not
+            on every robot.
     """
 
     name: str
@@ -348,6 +350,7 @@ class Api:
     same_length: tuple[tuple[str, ...], ...] = ()
     nan_rows: bool = True
     costly: bool = False
+    scene_free: bool = False
     notes: str = field(default="", compare=False)
 
     def __repr__(self) -> str:

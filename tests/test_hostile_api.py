@@ -1,20 +1,32 @@
 """Hostile input to every public Python function: the README's classes, the argument named,
 never a crash, never a silent wrong answer (issue 23).
 
-One row of :data:`APIS` per function of ``rpr3gen.__all__`` (and the public methods); the cases
+One row of :func:`apis` per function of ``rpr3gen.__all__`` (and the public methods); the cases
 are drawn from each argument's :class:`~hostile_kinds.Kind`: values of the wrong type
 (``InputTypeError``), bad values and shapes (``InputError``, or the function's own class),
 good values (the same answer as the plain float64 array), arrays of different lengths, NaN
 rows, empty and one-row inputs; then Hypothesis draws any value for any argument and checks
 the outcome against the kind's oracle. A new function joins by adding its row.
+
+The rows are a function of a :class:`Scene`: a robot, a motion it follows and every other input
+derived from the runtime. Every row that takes a model runs on each scene: the paper's robot,
+and general model files of several structures, ``models/rrr.toml`` (the committed ``rrr_1``,
+NumPy and C), ``models/prr.toml`` and ``models/ppr.toml`` (generated on first use into the
+session's cache; a 3-PPR has prismatic base joints and a ``reach`` that depends on its
+parameters only), on samples of ``models/loop.csv``. What a general model's legs do not share
+is refused there: ``identical_legs=True`` (an ``InputError`` naming it).
 """
 
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 import re
 import shutil
+import tomllib
+from collections.abc import Callable
+from functools import cached_property
 from pathlib import Path
 from typing import Any
 
@@ -53,44 +65,170 @@ from rpr3gen.errors import (
     TrajectoryError,
 )
 from rpr3gen.identification import Fit, inertial_parameters
+from rpr3gen.model import ACTUATIONS, Model
 from rpr3gen.structure import Structure
 
 SETTINGS = settings(
-    max_examples=20,
+    max_examples=250,
     deadline=None,
-    derandomize=True,
+    derandomize=False,
     database=None,
     suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much],
 )
 
-# -- data: small, valid, fast ---------------------------------------------------------------
+pytestmark = pytest.mark.usefixtures("variant_cache")  # general variants: derived once
 
-MODEL = rpr3gen.load_model()
-_RNG = np.random.default_rng(23)
+# -- scenes: a robot, a motion it follows, every other input from the runtime --------------
+
+ROOT = Path(__file__).resolve().parent.parent
+PAPER_TOML = Path(rpr3gen.model.__file__).parent / "models" / "paper.toml"
 N_FIT = 40  # identify: enough equations, well conditioned (condition number about 40)
-Q_FIT = _RNG.uniform(-1.0, 1.0, (N_FIT, 3)) * [0.03, 0.03, 0.2]
-QD_FIT = _RNG.normal(0.0, 1.0, (N_FIT, 3)) * [0.3, 0.3, 1.0]
-QDD_FIT = _RNG.normal(0.0, 1.0, (N_FIT, 3)) * [1.5, 1.5, 5.0]
-TAU_FIT = rpr3gen.regressor(MODEL, Q_FIT, QD_FIT, QDD_FIT) @ inertial_parameters(MODEL)
-TAU_FIT = TAU_FIT + rpr3gen.payload_efforts(MODEL, Q_FIT)
-Q, QD, QDD, TAU = Q_FIT[:4], QD_FIT[:4], QDD_FIT[:4], TAU_FIT[:4]
-QA = rpr3gen.actuator_coordinates(MODEL, Q[:2])
-FIT = rpr3gen.identify(MODEL, Q_FIT, QD_FIT, QDD_FIT, TAU_FIT)
-WMAP = rpr3gen.workspace(MODEL, 0.0, 2)
-EVALUATOR = rpr3gen.SampleEvaluator(MODEL, backend="numpy")
 T6 = np.linspace(0.0, 0.5, 6)
 Q6 = np.column_stack([0.01 * T6, -0.01 * T6, 0.1 * T6])
-PAPER_TOML = Path(rpr3gen.model.__file__).parent / "models" / "paper.toml"
 
 
-def _paper_copy(tmp: Path) -> str:
-    return str(shutil.copy(PAPER_TOML, tmp / "paper.toml"))
+@dataclasses.dataclass(frozen=True, eq=False)
+class Scene:
+    """What the rows evaluate: a model, ``N_FIT`` samples that identify it (poses, rates and
+    accelerations) and a motion of four samples; the efforts, actuator coordinates, fit,
+    workspace map and single-sample evaluator are derived from the runtime when first asked
+    for (inside a test: a general model's variant may have to be generated first).
+
+    Attributes:
+        backend: the backend of every call of the rows that take one.
+        shared_legs: ``identical_legs=True`` is meaningful (the paper's format describes one
+            leg for all three); a general model's legs, turned by 120 degrees, refuse it.
+    """
+
+    name: str
+    model: Model
+    file: Path
+    q_fit: np.ndarray
+    qd_fit: np.ndarray
+    qdd_fit: np.ndarray
+    q: np.ndarray
+    qd: np.ndarray
+    qdd: np.ndarray
+    backend: str = "numpy"
+    shared_legs: bool = True
+
+    def __repr__(self) -> str:
+        return self.name
+
+    @property
+    def paper(self) -> bool:
+        return self.model.structure.paper
+
+    @property
+    def backend_arg(self) -> dict[str, str]:
+        """``{"backend": ...}`` for a row whose function takes one (nothing for NumPy: the
+        default, so that the paper's calls stay as they were)."""
+        return {} if self.backend == "numpy" else {"backend": self.backend}
+
+    @cached_property
+    def tau_fit(self) -> np.ndarray:
+        """The efforts of the identification samples: ``Y @ pi + tau_payload``."""
+        Y = rpr3gen.regressor(self.model, self.q_fit, self.qd_fit, self.qdd_fit)
+        return Y @ inertial_parameters(self.model) + rpr3gen.payload_efforts(self.model, self.q_fit)
+
+    @cached_property
+    def tau(self) -> np.ndarray:
+        """The motion's actuator efforts (the inverse dynamics)."""
+        return rpr3gen.actuator_efforts(self.model, self.q, self.qd, self.qdd)
+
+    @cached_property
+    def qa(self) -> np.ndarray:
+        """(2, 3) the actuator coordinates of the motion's first two poses."""
+        return rpr3gen.actuator_coordinates(self.model, self.q[:2])
+
+    @cached_property
+    def fit(self) -> Fit:
+        return rpr3gen.identify(
+            self.model, self.q_fit, self.qd_fit, self.qdd_fit, self.tau_fit, **self.backend_arg
+        )
+
+    @cached_property
+    def wmap(self) -> rpr3gen.WorkspaceMap:
+        return rpr3gen.workspace(self.model, 0.0, 2)
+
+    @cached_property
+    def evaluator(self) -> rpr3gen.SampleEvaluator:
+        return rpr3gen.SampleEvaluator(self.model, backend=self.backend)
+
+    @cached_property
+    def functions(self) -> tuple[str, ...]:
+        """The generated functions of the model's variant."""
+        from rpr3gen import variants
+
+        return tuple(variants.load(self.model.structure, self.model.generated).functions)
+
+    @cached_property
+    def data(self) -> dict:
+        """The model file's tables (what :func:`rpr3gen.model_from_dict` takes)."""
+        with self.file.open("rb") as handle:
+            return tomllib.load(handle)
 
 
-def _paper_data() -> dict:
-    import tomllib
+def _paper() -> Scene:
+    """The paper's robot: random poses near the central configuration, random rates."""
+    rng = np.random.default_rng(23)
+    q = rng.uniform(-1.0, 1.0, (N_FIT, 3)) * [0.03, 0.03, 0.2]
+    qd = rng.normal(0.0, 1.0, (N_FIT, 3)) * [0.3, 0.3, 1.0]
+    qdd = rng.normal(0.0, 1.0, (N_FIT, 3)) * [1.5, 1.5, 5.0]
+    return Scene("paper", rpr3gen.load_model(), PAPER_TOML, q, qd, qdd, q[:4], qd[:4], qdd[:4])
 
-    return tomllib.loads(Path(PAPER_TOML).read_text())
+
+@functools.cache
+def _loop() -> rpr3gen.Trajectory:
+    """``models/loop.csv``: a closed loop inside the workspace of every gallery robot."""
+    return rpr3gen.read_trajectory_csv(ROOT / "models" / "loop.csv")
+
+
+def _general(file: str, backend: str = "numpy") -> Scene:
+    """A gallery model: every tenth pose of the loop with random rates (they identify), and
+    four samples of the loop itself (its rates and accelerations)."""
+    loop = _loop()
+    rng = np.random.default_rng(23)
+    fit = np.arange(N_FIT) * 10  # distinct poses (the loop is closed: t = 0 and 4 s coincide)
+    qd = rng.normal(0.0, 1.0, (N_FIT, 3)) * [0.3, 0.3, 1.0]
+    qdd = rng.normal(0.0, 1.0, (N_FIT, 3)) * [1.5, 1.5, 5.0]
+    motion = [25, 125, 225, 325]
+    name = Path(file).stem + ("" if backend == "numpy" else f"-{backend}")
+    return Scene(
+        name,
+        rpr3gen.load_model(ROOT / "models" / file),
+        ROOT / "models" / file,
+        loop.q[fit],
+        qd,
+        qdd,
+        loop.q[motion],
+        loop.qd[motion],
+        loop.qdd[motion],
+        backend=backend,
+        shared_legs=False,
+    )
+
+
+SCENES: dict[str, Callable[[], Scene]] = {
+    "paper": _paper,
+    "rrr": functools.partial(_general, "rrr.toml"),
+    "rrr-c": functools.partial(_general, "rrr.toml", backend="c"),
+    "prr": functools.partial(_general, "prr.toml"),
+    "ppr": functools.partial(_general, "ppr.toml"),
+}
+"""Every scene the rows that take a model run on (``rrr-c``: the C backend)."""
+FUZZED = ("rrr", "prr", "ppr")
+"""The general scenes Hypothesis draws from (the paper's is fuzzed on its own, as before)."""
+
+
+@functools.cache
+def scene(name: str) -> Scene:
+    return SCENES[name]()
+
+
+def _copy(s: Scene) -> Where:
+    """The scene's model file, copied into the test's folder."""
+    return Where(s.file.stem, lambda tmp: str(shutil.copy(s.file, tmp / s.file.name)))
 
 
 def _positions_csv(tmp: Path) -> str:
@@ -103,7 +241,6 @@ def _positions_csv(tmp: Path) -> str:
 
 # -- kinds particular to a few functions ----------------------------------------------------
 
-MODEL_KIND = instance(rpr3gen.Model, MODEL)
 MOTION = rows(3)
 
 
@@ -114,46 +251,74 @@ def _backend(value: Any) -> str | None:
 
 
 BACKEND = dataclasses.replace(choice("numpy"), classify=_backend)
+C_BACKEND = choice("numpy", "c")  # a scene of the C backend: its library is built already
 THREADS = optional(count(1, 4))
 CONDITIONING = number(least=0.0, below=1.0, good=(0.0, 0.5))
-FUNCTIONS = tuple(sorted(rpr3gen.manifest.load("revolute").functions))
+FUNCTIONS = tuple(sorted(rpr3gen.manifest.load("revolute").functions))  # every variant's
 MOTION_FUNCTIONS = ("actuator_efforts", "inverse_dynamics", "regressor")  # inputs q, qd, qdd
 
 
-def _motion_function(value: Any) -> str | None:
-    if not isinstance(value, str):
-        return "type"
-    return "ok" if value in MOTION_FUNCTIONS else None if value in FUNCTIONS else "value"
+def _function(s: Scene) -> Kind:
+    """``evaluate``'s function: one of the scene's variant (those of q, qd, qdd run)."""
+
+    def classify(value: Any) -> str | None:
+        if not isinstance(value, str):
+            return "type"
+        return "ok" if value in MOTION_FUNCTIONS else None if value in s.functions else "value"
+
+    return Kind(
+        "function",
+        classify,
+        wrong_types=(None, 5, ["inverse_dynamics"]),
+        bad_values=("nothing", "", "inverse-dynamics"),
+        good_values=MOTION_FUNCTIONS,
+    )
 
 
-FUNCTION = Kind(
-    "function",
-    _motion_function,
-    wrong_types=(None, 5, ["inverse_dynamics"]),
-    bad_values=("nothing", "", "inverse-dynamics"),
-    good_values=MOTION_FUNCTIONS,
-)
+def _bound_function(s: Scene) -> Kind:
+    """``SampleEvaluator``'s function: any of the scene's variant."""
+    kind = choice(*FUNCTIONS)
+
+    def classify(value: Any) -> str | None:
+        if not isinstance(value, str):
+            return "type"
+        return "ok" if value in s.functions else "value"
+
+    return dataclasses.replace(kind, classify=classify)
 
 
-def _inputs(value: Any) -> str | None:
-    if not isinstance(value, list | tuple):
-        return "type"
-    if len(value) != 3:
-        return "value"
-    verdicts = [MOTION.classify(v) for v in value]
-    if verdicts != ["ok"] * 3:
-        return None  # the first bad one decides
-    lengths = {len(np.atleast_2d(np.asarray(v, dtype=float))) for v in value}
-    return "ok" if len(lengths) == 1 else "value"
+def _inputs_kind(s: Scene) -> Kind:
+    def classify(value: Any) -> str | None:
+        if not isinstance(value, list | tuple):
+            return "type"
+        if len(value) != 3:
+            return "value"
+        verdicts = [MOTION.classify(v) for v in value]
+        if verdicts != ["ok"] * 3:
+            return None  # the first bad one decides
+        lengths = {len(np.atleast_2d(np.asarray(v, dtype=float))) for v in value}
+        return "ok" if len(lengths) == 1 else "value"
+
+    q, qd, qdd = s.q, s.qd, s.qdd
+    return Kind(
+        "inputs",
+        classify,
+        wrong_types=(q, "q", None, {"q": q}),
+        bad_values=((q,), (q, q, q, q), (q, qd[:3], qdd)),
+        good_values=((q, qd, qdd), [q, qd, qdd]),
+    )
 
 
-INPUTS = Kind(
-    "inputs",
-    _inputs,
-    wrong_types=(Q, "q", None, {"q": Q}),
-    bad_values=((Q,), (Q, Q, Q, Q), (Q, QD[:3], QDD)),
-    good_values=((Q, QD, QDD), [Q, QD, QDD]),
-)
+def _identical_legs(s: Scene) -> Kind:
+    """A flag; where the legs' parameters differ (a general model), True is refused."""
+    if s.shared_legs:
+        return flag()
+    return dataclasses.replace(
+        flag(),
+        classify=lambda v: ("value" if v else "ok") if isinstance(v, bool | np.bool_) else "type",
+        bad_values=(True, np.True_),
+        good_values=(False, np.False_),
+    )
 
 
 def _times(value: Any) -> str | None:
@@ -194,30 +359,46 @@ def _grid(value: Any) -> str | None:
     return None if isinstance(value, str | Path) else "type"
 
 
-GRID = Kind(
-    "grid",
-    _grid,
-    wrong_types=(None, 5, ["mass.m3"]),
-    bad_values=(
-        {},
-        {"mass.m9": [1.0]},
-        {"mass.m3": "heavy"},
-        {"mass.m3": [-1.0]},
-        {"mass.m3": {"start": 1.0, "stop": 2.0, "num": HUGE}},
-        {
-            f"mass.{key}": [1.0 + k for k in range(100)]  # 10^12 designs
-            for key in ("m1", "m2", "m3", "J1", "J2", "J3")
-        },
+#: A grid key of each format, a key it does not have, and six keys for 10^12 designs.
+GRID_KEYS = {
+    True: ("mass.m3", "mass.m9", tuple(f"mass.{k}" for k in ("m1", "m2", "m3", "J1", "J2", "J3"))),
+    False: (
+        "platform.mass",
+        "platform.mass9",
+        ("platform.mass", "platform.inertia", "legs.A.mass[0]", "legs.A.mass[1]",
+         "legs.A.inertia[0]", "legs.A.inertia[1]"),
     ),
-    value_error=GridError,
-)
-BASE_MODEL = Kind(
-    "base model",
-    lambda v: None if v is None or isinstance(v, str | Path | dict) else "type",
-    wrong_types=(5, ["paper.toml"], MODEL),
-    bad_values=({"name": "x"},),
-    value_error=ModelError,
-)
+}  # fmt: skip
+
+
+def _grid_kind(s: Scene) -> Kind:
+    key, unknown, six = GRID_KEYS[s.paper]
+    return Kind(
+        "grid",
+        _grid,
+        wrong_types=(None, 5, [key]),
+        bad_values=(
+            {},
+            {unknown: [1.0]},
+            {key: "heavy"},
+            {key: [-1.0]},
+            {key: {"start": 1.0, "stop": 2.0, "num": HUGE}},
+            {k: [1.0 + n for n in range(100)] for k in six},  # 10^12 designs
+        ),
+        value_error=GridError,
+    )
+
+
+def _base_model(s: Scene) -> Kind:
+    return Kind(
+        "base model",
+        lambda v: None if v is None or isinstance(v, str | Path | dict) else "type",
+        wrong_types=(5, ["paper.toml"], s.model),
+        bad_values=({"name": "x"},),
+        value_error=ModelError,
+    )
+
+
 TRAJECTORIES = Kind(
     "trajectories",
     lambda v: None if isinstance(v, list | tuple) else "type",
@@ -237,17 +418,80 @@ WORKERS = dataclasses.replace(  # only 0 runs: any other starts a Dask cluster
 RESUME = dataclasses.replace(  # True needs the out of an interrupted sweep
     flag(), classify=lambda v: None if v is True else flag().classify(v), good_values=(False,)
 )
-PARAMS = Kind(
-    "params",
-    lambda v: None if isinstance(v, dict) else "type",
-    wrong_types=("params", 5, None, [1.0]),
-    bad_values=(
-        {},
-        {**MODEL.params, "m1": math.nan},
-        {**MODEL.params, "extra": 1.0},
-    ),
-    value_error=ModelError,
-)
+
+
+def _params_kind(s: Scene) -> Kind:
+    mass = "m1" if s.paper else "m1_A"
+    return Kind(
+        "params",
+        lambda v: None if isinstance(v, dict) else "type",
+        wrong_types=("params", 5, None, [1.0]),
+        bad_values=(
+            {},
+            {**s.model.params, mass: math.nan},
+            {**s.model.params, "extra": 1.0},
+        ),
+        value_error=ModelError,
+    )
+
+
+def _actuation(s: Scene) -> Kind:
+    """The paper's format: either (it picks the variant); a general model: its structure's."""
+    if s.paper:
+        return dataclasses.replace(choice(*ACTUATIONS), value_error=ModelError)
+    own = s.model.actuation
+    (other,) = (a for a in ACTUATIONS if a != own)
+    kind = choice(own)
+    return dataclasses.replace(
+        kind, bad_values=(*kind.bad_values, other), good_values=(own,), value_error=ModelError
+    )
+
+
+def _structure(s: Scene) -> Kind:
+    """The model's own; None means the paper's format (of the actuation): a general model's
+    parameters are not its."""
+    kind = Kind(
+        "Structure",
+        lambda v: (
+            ("ok" if v == s.model.structure else None) if isinstance(v, Structure) else "type"
+        ),
+        wrong_types=("RPR", 1, {"leg": "RPR"}),
+        good_values=(s.model.structure,),
+        value_error=ModelError,
+    )
+    if s.paper:
+        return optional(kind)
+    return dataclasses.replace(
+        kind,
+        classify=lambda v: "value" if v is None else kind.classify(v),
+        bad_values=(None,),
+    )
+
+
+def _limits(s: Scene) -> Kind:
+    """A general model's joint bounds ``{"A.q2": (lo, hi)}`` (the paper's format has none)."""
+    bad: tuple[Any, ...] = (
+        ({"A.q1": (0.0, 1.0)},)  # the paper's format bounds its pistons with stroke
+        if s.paper
+        else (
+            {"A.q9": (0.0, 1.0)},
+            {"q1": (0.0, 1.0)},
+            {"A.q1": (1.0, 0.0)},
+            {"A.q1": (0.0, math.nan)},
+            {"A.q1": (0.0, 10**400)},
+            {"A.q1": (0.0,)},
+        )
+    )
+    return Kind(
+        "limits",
+        lambda v: "ok" if v is None else None if isinstance(v, dict) else "type",
+        wrong_types=(5, "A.q1", [("A.q1", (0.0, 1.0))]),
+        bad_values=bad,
+        good_values=(None, *((dict(s.model.limits),) if s.model.limits else ())),
+        value_error=ModelError,
+    )
+
+
 GENERATED = Kind(
     "generated folder",
     lambda v: None if isinstance(v, str | Path) else "type",
@@ -271,353 +515,388 @@ NAME = Kind(
 MOTION3 = (("q", "qd", "qdd"),)
 
 
-def _motion(n: int = 4) -> dict[str, Any]:
-    return {"model": MODEL, "q": Q[:n], "qd": QD[:n], "qdd": QDD[:n]}
-
-
 def _api(name: str, **fields: Any) -> Api:
     call = fields.pop("call", None) or getattr(rpr3gen, name)
     return Api(name=name, call=call, **fields)
 
 
-APIS: tuple[Api, ...] = (
-    _api(
-        "inverse_dynamics",
-        good=lambda tmp: _motion(),
-        kinds={
-            "model": MODEL_KIND,
-            "q": MOTION,
-            "qd": MOTION,
-            "qdd": MOTION,
-            "backend": BACKEND,
-            "progress": flag(),
-            "threads": THREADS,
-        },
-        same_length=MOTION3,
-    ),
-    _api(
-        "evaluate",
-        good=lambda tmp: {"model": MODEL, "function": "inverse_dynamics", "inputs": (Q, QD, QDD)},
-        kinds={
-            "model": MODEL_KIND,
-            "function": FUNCTION,
-            "inputs": INPUTS,
-            "backend": BACKEND,
-            "progress": flag(),
-            "threads": THREADS,
-        },
-    ),
-    _api(
-        "actuator_coordinates",
-        good=lambda tmp: {"model": MODEL, "q": Q},
-        kinds={"model": MODEL_KIND, "q": MOTION, "backend": BACKEND},
-    ),
-    _api(
-        "actuator_jacobian",
-        good=lambda tmp: {"model": MODEL, "q": Q},
-        kinds={"model": MODEL_KIND, "q": MOTION, "backend": BACKEND},
-    ),
-    _api(
-        "payload_efforts",
-        good=lambda tmp: {"model": MODEL, "q": Q},
-        kinds={"model": MODEL_KIND, "q": MOTION, "backend": BACKEND},
-    ),
-    _api(
-        "actuator_efforts",
-        good=lambda tmp: _motion(),
-        kinds={"model": MODEL_KIND, "q": MOTION, "qd": MOTION, "qdd": MOTION, "backend": BACKEND},
-        same_length=MOTION3,
-    ),
-    _api(
-        "regressor",
-        good=lambda tmp: _motion(),
-        kinds={
-            "model": MODEL_KIND,
-            "q": MOTION,
-            "qd": MOTION,
-            "qdd": MOTION,
-            "identical_legs": flag(),
-            "backend": BACKEND,
-        },
-        same_length=MOTION3,
-    ),
-    _api(
-        "base_regressor",
-        good=lambda tmp: _motion(),
-        kinds={
-            "model": MODEL_KIND,
-            "q": MOTION,
-            "qd": MOTION,
-            "qdd": MOTION,
-            "identical_legs": flag(),
-            "backend": BACKEND,
-        },
-        same_length=MOTION3,
-    ),
-    _api(
-        "jacobian_rate",
-        good=lambda tmp: {"model": MODEL, "q": Q, "qd": QD},
-        kinds={"model": MODEL_KIND, "q": MOTION, "qd": MOTION, "backend": BACKEND},
-        same_length=(("q", "qd"),),
-    ),
-    _api(
-        "task_space_dynamics",
-        good=lambda tmp: {"model": MODEL, "q": Q, "qd": QD},
-        kinds={"model": MODEL_KIND, "q": MOTION, "qd": MOTION, "backend": BACKEND},
-        same_length=(("q", "qd"),),
-    ),
-    _api(
-        "platform_velocity",
-        good=lambda tmp: {"model": MODEL, "q": Q, "qa_dot": QD},
-        kinds={"model": MODEL_KIND, "q": MOTION, "qa_dot": MOTION, "backend": BACKEND},
-        same_length=(("q", "qa_dot"),),
-    ),
-    _api(
-        "forward_dynamics",
-        good=lambda tmp: {"model": MODEL, "q": Q, "qd": QD, "tau": TAU},
-        kinds={"model": MODEL_KIND, "q": MOTION, "qd": MOTION, "tau": MOTION, "backend": BACKEND},
-        same_length=(("q", "qd", "tau"),),
-    ),
-    _api(
-        "assembly_modes",
-        good=lambda tmp: {"model": MODEL, "qa": QA[0]},
-        kinds={"model": MODEL_KIND, "qa": reading(3), "backend": BACKEND},
-    ),
-    _api(
-        "forward_kinematics",
-        good=lambda tmp: {"model": MODEL, "qa": QA, "near": Q[:2]},
-        kinds={"model": MODEL_KIND, "qa": MOTION, "near": MOTION, "backend": BACKEND},
-        same_length=(("qa", "near"),),
-    ),
-    _api(
-        "platform_radius",
-        good=lambda tmp: {"model": MODEL},
-        kinds={"model": MODEL_KIND},
-    ),
-    _api(
-        "base_parameters",
-        good=lambda tmp: {"model": MODEL},
-        kinds={"model": MODEL_KIND, "identical_legs": flag()},
-    ),
-    _api(
-        "inertial_parameters",
-        good=lambda tmp: {"model": MODEL},
-        kinds={"model": MODEL_KIND, "identical_legs": flag()},
-    ),
-    _api(
-        "identify",
-        good=lambda tmp: {"model": MODEL, "q": Q_FIT, "qd": QD_FIT, "qdd": QDD_FIT, "tau": TAU_FIT},
-        kinds={
-            "model": MODEL_KIND,
-            "q": MOTION,
-            "qd": MOTION,
-            "qdd": MOTION,
-            "tau": MOTION,
-            "friction": flag(),
-            "identical_legs": flag(),
-            "weights": optional(reading(3, positive=True)),
-            "max_condition": number(greater=1.0, finite=False, good=(1e3, math.inf)),
-            "t": optional(TIMES),
-            "backend": BACKEND,
-        },
-        same_length=(("q", "qd", "qdd", "tau", "t"),),
-        nan_rows=False,
-    ),
-    _api(
-        "excite",
-        good=lambda tmp: {"model": MODEL, "harmonics": 1, "samples": 10, "max_iterations": 1},
-        kinds={
-            "model": MODEL_KIND,
-            "harmonics": count(1, 1),
-            "period": number(greater=0.0),
-            "samples": count(10, 12),
-            "min_conditioning": CONDITIONING,
-            "max_acceleration": reading(2, positive=True),
-            "identical_legs": flag(),
-            "friction": flag(),
-            "seed": count(0, 2, huge_refused=False),
-            "max_iterations": count(1, 1, most=2**31 - 1),
-        },
-        costly=True,
-    ),
-    _api(
-        "workspace",
-        good=lambda tmp: {"model": MODEL, "resolution": 2},
-        kinds={
-            "model": MODEL_KIND,
-            "phi": number(good=(0.0, -1e-3)),
-            "resolution": count(2, 3),
-            "min_conditioning": CONDITIONING,
-        },
-    ),
-    _api(
-        "write_workspace",
-        good=lambda tmp: {"wmap": WMAP, "outdir": str(tmp / "ws")},
-        kinds={"wmap": instance(rpr3gen.WorkspaceMap), "outdir": output_path(folder=True)},
-        costly=True,
-    ),
-    _api(
-        "sweep",
-        good=lambda tmp: {
-            "model": None,
-            "grid": {"mass.m3": [3.0]},
-            "trajectories": ["rotation"],
-            "workers": 0,
-            "samples": 3,
-            "area_resolution": 0,
-        },
-        kinds={
-            "model": BASE_MODEL,
-            "grid": GRID,
-            "trajectories": TRAJECTORIES,
-            "out": optional(output_path(folder=False)),
-            "scheduler": Kind(
-                "scheduler",
-                lambda v: None if isinstance(v, str) or v is None else "type",
-                wrong_types=(5, ["tcp://x:1"]),
-            ),
-            "workers": WORKERS,
-            "resume": RESUME,
-            "chunk_size": count(1, 2, huge_refused=False),
-            "min_conditioning": CONDITIONING,
-            "area_resolution": AREA,
-            "samples": count(2, 5),
-            "duration": number(least=1e-6, most=1e9),
-            "progress": flag(),
-        },
-    ),
-    _api(
-        "load_model",
-        good=lambda tmp: {},
-        kinds={
-            "path": optional(
-                input_file(".toml", value_error=ModelError, good=Where("paper", _paper_copy))
-            ),
-            "generated": optional(GENERATED),
-        },
-    ),
-    _api(
-        "model_from_dict",
-        good=lambda tmp: {"data": _paper_data(), "source": "paper"},
-        kinds={
-            "data": Kind(
-                "model data (a mapping)",
-                lambda v: (
-                    "ok"
-                    if isinstance(v, dict) and v == _paper_data()
-                    else ("value" if isinstance(v, dict) else "type")
-                ),
-                # Bad contents are ModelErrors naming the key (tests/test_model.py).
-                wrong_types=("paper.toml", None, 5, [("name", "x")]),
-                good_values=(),
-                value_error=ModelError,
-            ),
-            "source": Kind(
-                "a str",
-                lambda v: "ok" if isinstance(v, str) else "type",
-                wrong_types=(None, 5, b"paper", ["paper"]),
-                good_values=("paper", "my robot"),
-            ),
-        },
-    ),
-    _api(
-        "paper_trajectory",
-        good=lambda tmp: {"name": "rotation", "samples": 5},
-        kinds={
-            "name": NAME,
-            "samples": count(2, 20, value_error=TrajectoryError),
-            "duration": number(least=1e-6, most=1e9, value_error=TrajectoryError),
-        },
-    ),
-    _api(
-        "read_trajectory_csv",
-        good=lambda tmp: {"path": _positions_csv(tmp)},
-        kinds={
-            "path": input_file(
-                ".csv", value_error=TrajectoryError, good=Where("positions", _positions_csv)
-            ),
-            "smoothing": optional(number(least=0.0, most=1e100, good=(0.0, 1e-6))),
-        },
-    ),
-    _api(
-        "Model",
-        good=lambda tmp: (
-            {f.name: getattr(MODEL, f.name) for f in dataclasses.fields(MODEL)}
-            | {"params": dict(MODEL.params)}
+def apis(s: Scene) -> tuple[Api, ...]:
+    """Every public function, its valid call on the scene ``s`` and its arguments' kinds (a
+    row of ``scene_free`` takes no model: it runs on the paper's scene only)."""
+    model, q, qd, qdd = s.model, s.q, s.qd, s.qdd
+    on = s.backend_arg  # the scene's backend, for a function that takes one
+
+    def motion() -> dict[str, Any]:
+        return {"model": model, "q": q, "qd": qd, "qdd": qdd, **on}
+
+    model_kind = instance(rpr3gen.Model, model)
+    backend = C_BACKEND if s.backend == "c" else BACKEND
+    identical_legs = _identical_legs(s)
+    grid_key = GRID_KEYS[s.paper][0]
+    return (
+        _api(
+            "inverse_dynamics",
+            good=lambda tmp: motion(),
+            kinds={
+                "model": model_kind,
+                "q": MOTION,
+                "qd": MOTION,
+                "qdd": MOTION,
+                "backend": backend,
+                "progress": flag(),
+                "threads": THREADS,
+            },
+            same_length=MOTION3,
         ),
-        kinds={
-            "name": Kind(
-                "name",
-                lambda v: "ok" if isinstance(v, str) else "type",
-                wrong_types=(3, None, ["paper"]),
+        _api(
+            "evaluate",
+            good=lambda tmp: {
+                "model": model,
+                "function": "inverse_dynamics",
+                "inputs": (q, qd, qdd),
+                **on,
+            },
+            kinds={
+                "model": model_kind,
+                "function": _function(s),
+                "inputs": _inputs_kind(s),
+                "backend": backend,
+                "progress": flag(),
+                "threads": THREADS,
+            },
+        ),
+        _api(
+            "actuator_coordinates",
+            good=lambda tmp: {"model": model, "q": q, **on},
+            kinds={"model": model_kind, "q": MOTION, "backend": backend},
+        ),
+        _api(
+            "actuator_jacobian",
+            good=lambda tmp: {"model": model, "q": q, **on},
+            kinds={"model": model_kind, "q": MOTION, "backend": backend},
+        ),
+        _api(
+            "payload_efforts",
+            good=lambda tmp: {"model": model, "q": q, **on},
+            kinds={"model": model_kind, "q": MOTION, "backend": backend},
+        ),
+        _api(
+            "actuator_efforts",
+            good=lambda tmp: motion(),
+            kinds={
+                "model": model_kind,
+                "q": MOTION,
+                "qd": MOTION,
+                "qdd": MOTION,
+                "backend": backend,
+            },
+            same_length=MOTION3,
+        ),
+        _api(
+            "regressor",
+            good=lambda tmp: motion(),
+            kinds={
+                "model": model_kind,
+                "q": MOTION,
+                "qd": MOTION,
+                "qdd": MOTION,
+                "identical_legs": identical_legs,
+                "backend": backend,
+            },
+            same_length=MOTION3,
+        ),
+        _api(
+            "base_regressor",
+            good=lambda tmp: motion(),
+            kinds={
+                "model": model_kind,
+                "q": MOTION,
+                "qd": MOTION,
+                "qdd": MOTION,
+                "identical_legs": identical_legs,
+                "backend": backend,
+            },
+            same_length=MOTION3,
+        ),
+        _api(
+            "jacobian_rate",
+            good=lambda tmp: {"model": model, "q": q, "qd": qd, **on},
+            kinds={"model": model_kind, "q": MOTION, "qd": MOTION, "backend": backend},
+            same_length=(("q", "qd"),),
+        ),
+        _api(
+            "task_space_dynamics",
+            good=lambda tmp: {"model": model, "q": q, "qd": qd, **on},
+            kinds={"model": model_kind, "q": MOTION, "qd": MOTION, "backend": backend},
+            same_length=(("q", "qd"),),
+        ),
+        _api(
+            "platform_velocity",
+            good=lambda tmp: {"model": model, "q": q, "qa_dot": qd, **on},
+            kinds={"model": model_kind, "q": MOTION, "qa_dot": MOTION, "backend": backend},
+            same_length=(("q", "qa_dot"),),
+        ),
+        _api(
+            "forward_dynamics",
+            good=lambda tmp: {"model": model, "q": q, "qd": qd, "tau": s.tau, **on},
+            kinds={
+                "model": model_kind,
+                "q": MOTION,
+                "qd": MOTION,
+                "tau": MOTION,
+                "backend": backend,
+            },
+            same_length=(("q", "qd", "tau"),),
+        ),
+        _api(
+            "assembly_modes",
+            good=lambda tmp: {"model": model, "qa": s.qa[0], **on},
+            kinds={"model": model_kind, "qa": reading(3), "backend": backend},
+        ),
+        _api(
+            "forward_kinematics",
+            good=lambda tmp: {"model": model, "qa": s.qa, "near": q[:2], **on},
+            kinds={"model": model_kind, "qa": MOTION, "near": MOTION, "backend": backend},
+            same_length=(("qa", "near"),),
+        ),
+        _api(
+            "platform_radius",
+            good=lambda tmp: {"model": model},
+            kinds={"model": model_kind},
+        ),
+        _api(
+            "base_parameters",
+            good=lambda tmp: {"model": model},
+            kinds={"model": model_kind, "identical_legs": identical_legs},
+        ),
+        _api(
+            "inertial_parameters",
+            good=lambda tmp: {"model": model},
+            kinds={"model": model_kind, "identical_legs": identical_legs},
+        ),
+        _api(
+            "identify",
+            good=lambda tmp: {
+                "model": model,
+                "q": s.q_fit,
+                "qd": s.qd_fit,
+                "qdd": s.qdd_fit,
+                "tau": s.tau_fit,
+                **on,
+            },
+            kinds={
+                "model": model_kind,
+                "q": MOTION,
+                "qd": MOTION,
+                "qdd": MOTION,
+                "tau": MOTION,
+                "friction": flag(),
+                "identical_legs": identical_legs,
+                "weights": optional(reading(3, positive=True)),
+                "max_condition": number(greater=1.0, finite=False, good=(1e3, math.inf)),
+                "t": optional(TIMES),
+                "backend": backend,
+            },
+            same_length=(("q", "qd", "qdd", "tau", "t"),),
+            nan_rows=False,
+        ),
+        _api(
+            "excite",
+            good=lambda tmp: {"model": model, "harmonics": 1, "samples": 10, "max_iterations": 1},
+            kinds={
+                "model": model_kind,
+                "harmonics": count(1, 1),
+                "period": number(greater=0.0),
+                "samples": count(10, 12),
+                "min_conditioning": CONDITIONING,
+                "max_acceleration": reading(2, positive=True),
+                "identical_legs": identical_legs,
+                "friction": flag(),
+                "seed": count(0, 2, huge_refused=False),
+                "max_iterations": count(1, 1, most=2**31 - 1),
+            },
+            costly=True,
+        ),
+        _api(
+            "workspace",
+            good=lambda tmp: {"model": model, "resolution": 2},
+            kinds={
+                "model": model_kind,
+                "phi": number(good=(0.0, -1e-3)),
+                "resolution": count(2, 3),
+                "min_conditioning": CONDITIONING,
+            },
+        ),
+        _api(
+            "write_workspace",
+            good=lambda tmp: {"wmap": s.wmap, "outdir": str(tmp / "ws")},
+            kinds={"wmap": instance(rpr3gen.WorkspaceMap), "outdir": output_path(folder=True)},
+            costly=True,
+        ),
+        _api(
+            "sweep",
+            good=lambda tmp: {
+                "model": None if s.paper else str(s.file),
+                "grid": {grid_key: [3.0]},
+                "trajectories": ["rotation"],
+                "workers": 0,
+                "samples": 3,
+                "area_resolution": 0,
+            },
+            kinds={
+                "model": _base_model(s),
+                "grid": _grid_kind(s),
+                "trajectories": TRAJECTORIES,
+                "out": optional(output_path(folder=False)),
+                "scheduler": Kind(
+                    "scheduler",
+                    lambda v: None if isinstance(v, str) or v is None else "type",
+                    wrong_types=(5, ["tcp://x:1"]),
+                ),
+                "workers": WORKERS,
+                "resume": RESUME,
+                "chunk_size": count(1, 2, huge_refused=False),
+                "min_conditioning": CONDITIONING,
+                "area_resolution": AREA,
+                "samples": count(2, 5),
+                "duration": number(least=1e-6, most=1e9),
+                "progress": flag(),
+            },
+        ),
+        _api(
+            "load_model",
+            good=lambda tmp: {} if s.paper else {"path": str(s.file)},
+            kinds={
+                "path": optional(input_file(".toml", value_error=ModelError, good=_copy(s))),
+                "generated": optional(GENERATED),
+            },
+        ),
+        _api(
+            "model_from_dict",
+            good=lambda tmp: {"data": s.data, "source": s.name},
+            kinds={
+                "data": Kind(
+                    "model data (a mapping)",
+                    lambda v: (
+                        "ok"
+                        if isinstance(v, dict) and v == s.data
+                        else (None if isinstance(v, dict) else "type")
+                    ),
+                    # Bad contents are ModelErrors naming the key, not the argument: judged
+                    # in tests/test_model.py and tests/test_planar_model_errors.py.
+                    wrong_types=("paper.toml", None, 5, [("name", "x")]),
+                    good_values=(),
+                    value_error=ModelError,
+                ),
+                "source": Kind(
+                    "a str",
+                    lambda v: "ok" if isinstance(v, str) else "type",
+                    wrong_types=(None, 5, b"paper", ["paper"]),
+                    good_values=("paper", "my robot"),
+                ),
+            },
+        ),
+        _api(
+            "paper_trajectory",
+            good=lambda tmp: {"name": "rotation", "samples": 5},
+            kinds={
+                "name": NAME,
+                "samples": count(2, 20, value_error=TrajectoryError),
+                "duration": number(least=1e-6, most=1e9, value_error=TrajectoryError),
+            },
+            scene_free=True,
+        ),
+        _api(
+            "read_trajectory_csv",
+            good=lambda tmp: {"path": _positions_csv(tmp)},
+            kinds={
+                "path": input_file(
+                    ".csv", value_error=TrajectoryError, good=Where("positions", _positions_csv)
+                ),
+                "smoothing": optional(number(least=0.0, most=1e100, good=(0.0, 1e-6))),
+            },
+            scene_free=True,
+        ),
+        _api(
+            "Model",
+            good=lambda tmp: (
+                {f.name: getattr(model, f.name) for f in dataclasses.fields(model)}
+                | {"params": dict(model.params)}
             ),
-            "actuation": dataclasses.replace(
-                choice("revolute", "prismatic"), value_error=ModelError
-            ),
-            "params": PARAMS,
-            "stroke": Kind(
-                "stroke",
-                lambda v: None,
-                wrong_types=("wide", 5),
-                bad_values=([[0.1, -0.1]] * 3, [[0.0, 1.0]], [[0.0, math.nan]] * 3),
-                value_error=ModelError,
-            ),
-            "generated": optional(GENERATED),
-            "structure": optional(
-                Kind(
-                    "Structure",
-                    lambda v: "ok" if isinstance(v, Structure) else "type",
-                    wrong_types=("RPR", 1, {"leg": "RPR"}),
-                    good_values=(MODEL.structure,),
-                )
-            ),
-            "limits": Kind(
-                "limits",
-                lambda v: "ok" if v is None else None,
-                good_values=(None,),
-            ),
-        },
-    ),
-    _api(
-        "SampleEvaluator",
-        good=lambda tmp: {"model": MODEL, "backend": "numpy"},
-        kinds={"model": MODEL_KIND, "backend": BACKEND, "function": choice(*FUNCTIONS)},
-    ),
-    _api(
-        "SampleEvaluator.evaluate",
-        call=lambda q, qd, qdd: EVALUATOR.evaluate(q, qd, qdd),
-        good=lambda tmp: {"q": Q[0], "qd": QD[0], "qdd": QDD[0]},
-        kinds={"q": reading(3), "qd": reading(3), "qdd": reading(3)},
-    ),
-    _api(
-        "Trajectory",
-        good=lambda tmp: {"t": T6[:4], "q": Q, "qd": QD, "qdd": QDD},
-        kinds={"t": T_KIND, "q": EXACT_ROWS, "qd": EXACT_ROWS, "qdd": EXACT_ROWS},
-    ),
-    _api(
-        "Trajectory.from_positions",
-        call=rpr3gen.Trajectory.from_positions,
-        good=lambda tmp: {"t": T6, "q": Q6},
-        kinds={
-            "t": dataclasses.replace(
-                T_KIND,
-                classify=lambda v: None,
-                bad_values=([0.0, 0.0, 1.0, 2.0, 3.0, 4.0], [0.0, math.nan, 1.0, 2.0, 3.0, 4.0]),
-            ),
-            "q": dataclasses.replace(EXACT_ROWS, bad_values=(np.zeros((6, 2)), np.zeros(3))),
-            "smoothing": number(least=0.0, most=1e100, good=(0.0,)),
-            "source": Kind("source", lambda v: "ok" if isinstance(v, str) else "type"),
-        },
-    ),
-    _api(
-        "Fit.predict",
-        call=FIT.predict,
-        good=lambda tmp: {"q": Q, "qd": QD, "qdd": QDD},
-        kinds={"q": MOTION, "qd": MOTION, "qdd": MOTION},
-        same_length=MOTION3,
-    ),
-)
-"""Every public function, its valid call and its arguments' kinds."""
+            kinds={
+                "name": Kind(
+                    "name",
+                    lambda v: "ok" if isinstance(v, str) else "type",
+                    wrong_types=(3, None, ["paper"]),
+                ),
+                "actuation": _actuation(s),
+                "params": _params_kind(s),
+                "stroke": Kind(
+                    "stroke",
+                    lambda v: None,
+                    wrong_types=("wide", 5),
+                    bad_values=([[0.1, -0.1]] * 3, [[0.0, 1.0]], [[0.0, math.nan]] * 3),
+                    value_error=ModelError,
+                ),
+                "generated": optional(GENERATED),
+                "structure": _structure(s),
+                "limits": _limits(s),
+            },
+        ),
+        _api(
+            "SampleEvaluator",
+            good=lambda tmp: {"model": model, "backend": s.backend},
+            kinds={"model": model_kind, "backend": backend, "function": _bound_function(s)},
+        ),
+        _api(
+            "SampleEvaluator.evaluate",
+            call=lambda q, qd, qdd: s.evaluator.evaluate(q, qd, qdd),
+            good=lambda tmp: {"q": q[0], "qd": qd[0], "qdd": qdd[0]},
+            kinds={"q": reading(3), "qd": reading(3), "qdd": reading(3)},
+        ),
+        _api(
+            "Trajectory",
+            good=lambda tmp: {"t": T6[:4], "q": q, "qd": qd, "qdd": qdd},
+            kinds={"t": T_KIND, "q": EXACT_ROWS, "qd": EXACT_ROWS, "qdd": EXACT_ROWS},
+            scene_free=True,
+        ),
+        _api(
+            "Trajectory.from_positions",
+            call=rpr3gen.Trajectory.from_positions,
+            good=lambda tmp: {"t": T6, "q": Q6},
+            kinds={
+                "t": dataclasses.replace(
+                    T_KIND,
+                    classify=lambda v: None,
+                    bad_values=(
+                        [0.0, 0.0, 1.0, 2.0, 3.0, 4.0],
+                        [0.0, math.nan, 1.0, 2.0, 3.0, 4.0],
+                    ),
+                ),
+                "q": dataclasses.replace(EXACT_ROWS, bad_values=(np.zeros((6, 2)), np.zeros(3))),
+                "smoothing": number(least=0.0, most=1e100, good=(0.0,)),
+                "source": Kind("source", lambda v: "ok" if isinstance(v, str) else "type"),
+            },
+            scene_free=True,
+        ),
+        _api(
+            "Fit.predict",
+            call=lambda q, qd, qdd: s.fit.predict(q, qd, qdd),
+            good=lambda tmp: {"q": q, "qd": qd, "qdd": qdd},
+            kinds={"q": MOTION, "qd": MOTION, "qdd": MOTION},
+            same_length=MOTION3,
+        ),
+    )
+
+
+@functools.cache
+def table(name: str) -> dict[str, Api]:
+    """The rows on the scene ``name``, by function (built without evaluating anything)."""
+    return {api.name: api for api in apis(scene(name))}
+
+
+APIS: tuple[Api, ...] = tuple(table("paper").values())
+"""Every public function's row, on the paper's scene."""
 
 #: What may be refused although every argument is valid alone: a pose out of reach, data that
 #: do not identify, a reading the generated code refuses (documented refusals, not crashes).
@@ -654,14 +933,30 @@ def test_every_public_name_has_a_row() -> None:
 # -- the cases ------------------------------------------------------------------------------
 
 
-def _arguments(attribute: str) -> list[Any]:
-    """(api, argument) pairs whose kind has values of ``attribute``; one test case each, which
-    tries every value (a case per value would cost pytest's overhead a thousand times). Good
-    values of a costly function are left to its own tests."""
+def _scenes(api: Api) -> tuple[str, ...]:
+    """The scenes a row runs on: every one, or the paper's for a row that takes no model."""
+    return ("paper",) if api.scene_free else tuple(SCENES)
+
+
+def _rows(keep: Callable[[Api], bool] = lambda api: True) -> list[Any]:
+    """(scene, function) of every row ``keep`` keeps, on each of its scenes."""
     return [
-        pytest.param(api, name, id=f"{api.name}-{name}")
+        pytest.param(where, api.name, id=f"{where}-{api.name}")
         for api in APIS
-        for name, kind in api.kinds.items()
+        for where in _scenes(api)
+        if keep(table(where)[api.name])
+    ]
+
+
+def _arguments(attribute: str) -> list[Any]:
+    """(scene, function, argument) whose kind has values of ``attribute``; one test case each,
+    which tries every value (a case per value would cost pytest's overhead a thousand times).
+    Good values of a costly function are left to its own tests."""
+    return [
+        pytest.param(where, api.name, name, id=f"{where}-{api.name}-{name}")
+        for api in APIS
+        for where in _scenes(api)
+        for name, kind in table(where)[api.name].kinds.items()
         if getattr(kind, attribute) and not (attribute == "good_values" and api.costly)
     ]
 
@@ -690,8 +985,12 @@ def _assert_names(exc: BaseException, name: str, *paths: str) -> None:
     assert named or any(p in message for p in paths), (name, paths, message)
 
 
-@pytest.mark.parametrize(("api", "name"), _arguments("wrong_types"))
-def test_a_wrong_type_is_an_input_type_error_naming_it(api: Api, name: str, tmp_path: Path) -> None:
+@pytest.mark.parametrize(("where", "function", "name"), _arguments("wrong_types"))
+def test_a_wrong_type_is_an_input_type_error_naming_it(
+    where: str, function: str, name: str, tmp_path: Path
+) -> None:
+    api = table(where)[function]
+
     def check(value: Any) -> None:
         with pytest.raises(InputTypeError) as info:
             _call(api, tmp_path, **{name: value})
@@ -700,8 +999,12 @@ def test_a_wrong_type_is_an_input_type_error_naming_it(api: Api, name: str, tmp_
     _every(api.kinds[name].wrong_types, check)
 
 
-@pytest.mark.parametrize(("api", "name"), _arguments("bad_values"))
-def test_a_bad_value_is_the_promised_error_naming_it(api: Api, name: str, tmp_path: Path) -> None:
+@pytest.mark.parametrize(("where", "function", "name"), _arguments("bad_values"))
+def test_a_bad_value_is_the_promised_error_naming_it(
+    where: str, function: str, name: str, tmp_path: Path
+) -> None:
+    api = table(where)[function]
+
     def check(value: Any) -> None:
         with pytest.raises(Rpr3genError) as info:
             _call(api, tmp_path, **{name: value})
@@ -735,8 +1038,12 @@ def _same(a: Any, b: Any) -> None:
         assert np.array_equal(x, y, equal_nan=x.dtype.kind == "f"), (x, y)
 
 
-@pytest.mark.parametrize(("api", "name"), _arguments("good_values"))
-def test_a_good_value_is_taken_as_its_float64_array(api: Api, name: str, tmp_path: Path) -> None:
+@pytest.mark.parametrize(("where", "function", "name"), _arguments("good_values"))
+def test_a_good_value_is_taken_as_its_float64_array(
+    where: str, function: str, name: str, tmp_path: Path
+) -> None:
+    api = table(where)[function]
+
     def check(value: Any) -> None:
         result = _call(api, tmp_path, **{name: value})
         if api.kinds[name].rows and value is not None:
@@ -750,10 +1057,10 @@ def _row_groups(api: Api) -> list[tuple[str, ...]]:
     return [tuple(arrays)] if arrays else []
 
 
-ROWED = [api for api in APIS if _row_groups(api) and api.name != "Trajectory"]
+ROWED = _rows(lambda api: bool(_row_groups(api)) and api.name != "Trajectory")
 
 
-@pytest.mark.parametrize("api", ROWED)
+@pytest.mark.parametrize(("where", "function"), ROWED)
 @pytest.mark.parametrize(
     "like",
     [
@@ -762,7 +1069,10 @@ ROWED = [api for api in APIS if _row_groups(api) and api.name != "Trajectory"]
         lambda a: a.astype(np.float32).astype(object),
     ],
 )
-def test_an_array_like_is_taken_as_its_float64_array(api: Api, like: Any, tmp_path: Path) -> None:
+def test_an_array_like_is_taken_as_its_float64_array(
+    where: str, function: str, like: Any, tmp_path: Path
+) -> None:
+    api = table(where)[function]
     (names,) = _row_groups(api)
     good = api.good(tmp_path)
     given_ = {n: like(np.asarray(good[n])) for n in names}
@@ -770,8 +1080,11 @@ def test_an_array_like_is_taken_as_its_float64_array(api: Api, like: Any, tmp_pa
     _same(_call(api, tmp_path, **given_), _call(api, tmp_path, **floats))
 
 
-@pytest.mark.parametrize("api", [a for a in APIS if a.same_length])
-def test_arrays_of_different_lengths_are_refused_naming_them(api: Api, tmp_path: Path) -> None:
+@pytest.mark.parametrize(("where", "function"), _rows(lambda api: bool(api.same_length)))
+def test_arrays_of_different_lengths_are_refused_naming_them(
+    where: str, function: str, tmp_path: Path
+) -> None:
+    api = table(where)[function]
     for group in api.same_length:
         present = [n for n in group if n != "t"]
         good = api.good(tmp_path)
@@ -782,8 +1095,11 @@ def test_arrays_of_different_lengths_are_refused_naming_them(api: Api, tmp_path:
             assert name in str(info.value), str(info.value)
 
 
-@pytest.mark.parametrize("api", ROWED)
-def test_one_row_and_one_sample_are_the_same_answer(api: Api, tmp_path: Path) -> None:
+@pytest.mark.parametrize(("where", "function"), ROWED)
+def test_one_row_and_one_sample_are_the_same_answer(
+    where: str, function: str, tmp_path: Path
+) -> None:
+    api = table(where)[function]
     (names,) = _row_groups(api)
     good = api.good(tmp_path)
     if not api.nan_rows:  # a function that needs many samples refuses one
@@ -794,8 +1110,11 @@ def test_one_row_and_one_sample_are_the_same_answer(api: Api, tmp_path: Path) ->
     _same(one, _call(api, tmp_path, **{n: np.asarray(good[n])[:1] for n in names}))
 
 
-@pytest.mark.parametrize("api", ROWED)
-def test_empty_input_is_an_empty_answer_or_refused(api: Api, tmp_path: Path) -> None:
+@pytest.mark.parametrize(("where", "function"), ROWED)
+def test_empty_input_is_an_empty_answer_or_refused(
+    where: str, function: str, tmp_path: Path
+) -> None:
+    api = table(where)[function]
     (names,) = _row_groups(api)
     empty = {n: np.zeros((0, 3)) for n in names}
     if not api.nan_rows:
@@ -808,11 +1127,12 @@ def test_empty_input_is_an_empty_answer_or_refused(api: Api, tmp_path: Path) -> 
             assert leaf.shape[0] == 0, leaf.shape
 
 
-@pytest.mark.parametrize("api", ROWED)
+@pytest.mark.parametrize(("where", "function"), ROWED)
 @pytest.mark.parametrize("bad", [math.nan, math.inf])
 def test_a_non_finite_row_is_a_nan_row_and_the_others_are_kept(
-    api: Api, bad: float, tmp_path: Path
+    where: str, function: str, bad: float, tmp_path: Path
 ) -> None:
+    api = table(where)[function]
     (names,) = _row_groups(api)
     good = api.good(tmp_path)
     spoiled = np.array(good[names[0]], dtype=float)
@@ -831,9 +1151,44 @@ def test_a_non_finite_row_is_a_nan_row_and_the_others_are_kept(
             assert np.array_equal(got[keep], want[keep], equal_nan=True)
 
 
-def test_one_reading_refuses_two_rather_than_use_the_first() -> None:
+@pytest.mark.parametrize("where", list(SCENES))
+def test_one_reading_refuses_two_rather_than_use_the_first(where: str) -> None:
+    s = scene(where)
     with pytest.raises(InputError, match=r"qa: must have shape \(3,\), got \(2, 3\)"):
-        rpr3gen.assembly_modes(MODEL, QA)
+        rpr3gen.assembly_modes(s.model, s.qa, **s.backend_arg)
+
+
+@pytest.mark.parametrize("where", list(SCENES))
+def test_a_scene_is_a_motion_the_robot_follows(where: str) -> None:
+    """The good calls are not vacuous: every sample of the scene is inside the workspace (no
+    NaN row), its inputs agree (the efforts of the regressor are the inverse dynamics', the
+    poses come back from the actuator coordinates) and its data identify the robot."""
+    s = scene(where)
+    for q, qd, qdd in ((s.q, s.qd, s.qdd), (s.q_fit, s.qd_fit, s.qdd_fit)):
+        out = rpr3gen.inverse_dynamics(s.model, q, qd, qdd, **s.backend_arg)
+        assert all(np.isfinite(v).all() for v in out.values()), where
+        assert (out["conditioning"] > 0.02).all()
+        assert (out["reach"] > 0.02).all()
+    efforts = rpr3gen.actuator_efforts(s.model, s.q_fit, s.qd_fit, s.qdd_fit)
+    assert np.allclose(s.tau_fit, efforts, rtol=1e-9, atol=1e-9 * np.abs(efforts).max())
+    near = rpr3gen.forward_kinematics(s.model, s.qa, s.q[:2], **s.backend_arg)
+    assert np.allclose(near, s.q[:2], rtol=0.0, atol=1e-12)
+    assert s.fit.condition_number < 1e3
+    assert np.allclose(s.fit.predict(s.q, s.qd, s.qdd), s.tau, rtol=1e-7, atol=1e-7)
+
+
+@pytest.mark.parametrize("where", [w for w in SCENES if not scene(w).shared_legs])
+def test_identical_legs_is_refused_where_the_legs_differ(where: str, tmp_path: Path) -> None:
+    """A general model's legs turned by 120 degrees do not share their inertial parameters:
+    every function that would share them refuses, naming the leg, rather than fit a robot
+    that is not this one."""
+    checked = []
+    for api in table(where).values():
+        if "identical_legs" in api.kinds:
+            with pytest.raises(InputError, match=r"^identical_legs: leg B's .* differ"):
+                _call(api, tmp_path, identical_legs=True)
+            checked.append(api.name)
+    assert len(checked) == 6, checked
 
 
 # -- Hypothesis: any value for any argument ---------------------------------------------------
@@ -893,12 +1248,26 @@ def fuzz_tmp(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return tmp_path_factory.mktemp("fuzz")
 
 
-@pytest.mark.parametrize("api", [a for a in APIS if a.kinds], ids=lambda a: a.name)
+def _fuzzed() -> list[Any]:
+    """(function, scenes): each row on the paper's scene, and each that takes a model on a
+    general scene Hypothesis draws (as many examples each: the paper's stay as many)."""
+    cases = []
+    for api in APIS:
+        if api.kinds:
+            cases.append(pytest.param(api.name, ("paper",), id=f"{api.name}-paper"))
+            if not api.scene_free:
+                cases.append(pytest.param(api.name, FUZZED, id=f"{api.name}-general"))
+    return cases
+
+
+@pytest.mark.parametrize(("function", "scenes"), _fuzzed())
 @SETTINGS
 @given(data=st.data())
 def test_any_value_is_taken_or_refused_as_promised(
-    api: Api, fuzz_tmp: Path, data: st.DataObject
+    function: str, scenes: tuple[str, ...], fuzz_tmp: Path, data: st.DataObject
 ) -> None:
+    where = data.draw(st.sampled_from(scenes), label="scene") if len(scenes) > 1 else scenes[0]
+    api = table(where)[function]
     tmp = fuzz_tmp
     name = data.draw(st.sampled_from(sorted(api.kinds)), label="argument")
     value = _value_for(api, name, data)
