@@ -19,6 +19,9 @@ BEGIN = "<!-- performance: written by `python benchmarks/run.py --readme`; do no
 END = "<!-- end of performance -->"
 #: The tick's generated calls in the Python example (control_loop.py's Controller).
 TICK_CALLS = ("forward_kinematics", "platform_velocity", "actuator_efforts")
+#: The functions of the structures' compact table (the forward kinematics has no NumPy version
+#: and no C row: its modes are ``assembly_modes``).
+KEY_FUNCTIONS = ("inverse_dynamics", "forward_dynamics", "assembly_modes", "actuator_jacobian")
 
 
 def table(head: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
@@ -50,17 +53,29 @@ def header(r: dict[str, Any]) -> str:
 
 
 def c_figures(r: dict[str, Any], key: str) -> dict[str, dict[str, float]]:
-    """``{function: {"floor", "single", "batch": ns, "agree": 0|1}}``: the best of the repeats
-    (the least disturbed by other processes: the machine is shared)."""
+    """``{function: {"floor", "single", "batch": ns, "agree": 0|1, "failed": n}}``: the best of
+    the repeats (the least disturbed by other processes: the machine is shared); ``failed``:
+    the samples on which a single call failed."""
     found: dict[str, dict[str, float]] = {}
     for name, value in r["c"][key]["results"].items():
         function, what = name.split("/")
-        found.setdefault(function, {})[what] = value["agree"] if what == "agree" else value["min"]
+        if what == "agree":
+            found.setdefault(function, {}).update(agree=value["agree"],
+                                                  failed=value["failed_single"])  # fmt: skip
+        else:
+            found.setdefault(function, {})[what] = value["min"]
     return found
 
 
-def variants(r: dict[str, Any]) -> list[str]:
-    return sorted({key.split("/")[0] for key in r["c"]})
+def paper(r: dict[str, Any]) -> list[str]:
+    """The paper's variants of the run (a run before the structures: every variant in it)."""
+    return list(r["paper"]) if "paper" in r else sorted({key.split("/")[0] for key in r["c"]})
+
+
+def agreed(x: dict[str, float]) -> str:
+    """The ``single = batch`` cell: the bit check, and the failed samples if any."""
+    cell = "yes" if x["agree"] == 1 else "**no**"
+    return cell + (f", **{x['failed']:.0f} failed**" if x.get("failed") else "")
 
 
 def py(r: dict[str, Any], name: str) -> float | None:
@@ -83,7 +98,7 @@ def ne_ratios(r: dict[str, Any], variant: str) -> list[tuple[str, int, float, fl
 
 def targets(r: dict[str, Any]) -> str:
     rows = []
-    for v in variants(r):
+    for v in paper(r):
         c = c_figures(r, f"{v}/generic")
         for f, goal in (("inverse_dynamics", 2.0), ("forward_dynamics", 2.0)):
             x = c[f]["single"] / c[f]["floor"]
@@ -135,20 +150,73 @@ def functions(r: dict[str, Any], v: str) -> str:
         cells = [f"`{f}`", ns(x["floor"])]
         cells += [f"{ns(x[k])} = {x[k] / x['floor']:.2f}x" for k in ("single", "batch")]
         cells.append(f"{ns(numpy * 1e4)} = {numpy * 1e4 / x['floor']:.2f}x" if numpy else "")
-        cells.append("yes" if x["agree"] == 1 else "**no**")
+        cells.append(agreed(x))
         rows.append(cells)
-    rot = c_figures(r, f"{v}/rotation")["inverse_dynamics"]
-    rows.append(["`inverse_dynamics`, rotation motion", ns(rot["floor"]),
-                 *(f"{ns(rot[k])} = {rot[k] / rot['floor']:.2f}x" for k in ("single", "batch")),
-                 "", "yes" if rot["agree"] == 1 else "**no**"])  # fmt: skip
+    if f"{v}/rotation" in r["c"]:
+        rot = c_figures(r, f"{v}/rotation")["inverse_dynamics"]
+        rows.append(["`inverse_dynamics`, rotation motion", ns(rot["floor"]),
+                     *(f"{ns(rot[k])} = {rot[k] / rot['floor']:.2f}x" for k in ("single", "batch")),
+                     "", agreed(rot)])  # fmt: skip
     flags = r["c"][f"{v}/generic"]["flags"]
     head = ["function", "floor", "C single", "C batch", "NumPy", "single = batch"]
     return f"**{v}** (`cc {flags}`; ns per sample, best of the repeats):\n\n" + table(head, rows)
 
 
+def ratio(x: float) -> str:
+    """A ratio to its floor: two figures (``0.96``, ``2.3``, ``12``, ``150``)."""
+    return f"{x:.2f}" if x < 1 else f"{x:.1f}" if x < 10 else f"{x:.0f}"
+
+
+def title(variant: str) -> str:
+    """``3-PRR/2``: a structure's leg type and actuated joint, from its variant's name."""
+    leg, _, joint = variant.partition("_")
+    return f"3-{leg.upper()}/{joint}"
+
+
+def structures(r: dict[str, Any]) -> str:
+    """The compact table: per structure its generation times and, for :data:`KEY_FUNCTIONS`,
+    C single, C batch and NumPy against the function's floor."""
+    rows = []
+    for v in r.get("structures", []):
+        g, c = r["generation"][v], c_figures(r, f"{v}/generic")
+        cached = sum(g["cached"][k] for k in ("derive", "numpy", "c"))
+        cold = f"{g['cold']['derive']:.1f} + {g['cold']['c']:.1f} s"
+        cells = [f"{title(v)} `{v}`", f"{g['model']}; x{g['scale']:.2g}", cold,
+                 f"{cached * 1e3:.0f} ms"]  # fmt: skip
+        for f in KEY_FUNCTIONS:
+            x, numpy = c[f], py(r, f"functions/{v}/{f}")
+            ratios = [ratio(x[k] / x["floor"]) for k in ("single", "batch")]
+            cells.append(" / ".join([*ratios, ratio(numpy * 1e4 / x["floor"]) if numpy else "-"]))
+        cells.append(agreed({"agree": min(x["agree"] for x in c.values()),
+                             "failed": sum(x["failed"] for x in c.values())}))  # fmt: skip
+        rows.append(cells)
+    head = ["structure", "model; motion's scale", "generation: derive + C build", "cached",
+            *(f"`{f}`" for f in KEY_FUNCTIONS), "single = batch"]  # fmt: skip
+    return (
+        "Generation: the variant's first use in a fresh interpreter with an empty cache "
+        "(SymPy derivation and emission, then the C library's build) and in a second fresh "
+        "interpreter (finding the variant, importing its NumPy module, loading its C "
+        "library). Per function: C single / floor, C batch / floor, NumPy (10^5 samples) / "
+        "floor, on the structure's generic motion.\n\n" + table(head, rows)
+    )
+
+
+def generation(r: dict[str, Any]) -> str:
+    """Every step of every structure's first uses, cold and cached (seconds)."""
+    steps = ("import", "derive", "numpy", "c", "wall")
+    rows = []
+    for v in r.get("structures", []):
+        g = r["generation"][v]
+        rows.append([f"`{v}`", *(f"{g[kind][k]:.3f}" for kind in ("cold", "cached")
+                                 for k in steps)])  # fmt: skip
+    label = {"wall": "process"}
+    head = [f"{kind}: {label.get(k, k)}" for kind in ("cold", "cached") for k in steps]
+    return table(["variant", *head], rows)
+
+
 def numpy_vs_ne(r: dict[str, Any]) -> str:
     rows = [[v, m, f"10^{len(str(n)) - 1}", f"{ours:.0f} ns", f"{ne:.0f} ns", f"{ne / ours:.1f}x"]
-            for v in variants(r) for m, n, ours, ne in ne_ratios(r, v)]  # fmt: skip
+            for v in paper(r) for m, n, ours, ne in ne_ratios(r, v)]  # fmt: skip
     return table(["variant", "motion", "samples", "NumPy", "Newton–Euler", "ratio"], rows)
 
 
@@ -180,17 +248,22 @@ def calls(r: dict[str, Any]) -> str:
     return table(["variant", "function", "call (µs)", "NaN input: the ctypes floor", "the C"], rows)
 
 
-def document(r: dict[str, Any]) -> str:
+FLOOR = (
+    "*Floor*: the libm calls the function's generated kernel makes (sin, cos, sqrt, atan2), in a "
+    "loop, nothing else. *C single*: the function once per sample, back to back; *C batch*: over "
+    "chunks of 1,000 samples, outputs in cache; *NumPy*: `evaluate` at 10^5 samples (allocation "
+    "and checks included), ns per sample.\n"
+)
+
+
+def paper_parts(r: dict[str, Any]) -> list[str]:
+    """The paper's robot's sections (a run of some structures alone has none)."""
     peers = [f"`mj_forward` ({name.split('/')[1]}) {py(r, name) * 1e6:.2f} µs"  # type: ignore[operator]
              for name in sorted(r["python"]) if name.startswith("peers/")]  # fmt: skip
-    parts = [
-        "# Benchmark results\n", header(r), "\n## Targets\n", targets(r),
-        "\n## Every function against its floor (generic motion)\n",
-        "*Floor*: the libm calls the function's generated kernel makes (sin, cos, sqrt, atan2), "
-        "in a loop, nothing else. *C single*: the function once per sample, back to back; "
-        "*C batch*: over chunks of 1,000 samples, outputs in cache; *NumPy*: `evaluate` at "
-        "10^5 samples (allocation and checks included), ns per sample.\n",
-        *(functions(r, v) + "\n" for v in variants(r)),
+    return [
+        "\n## Targets\n", targets(r),
+        "\n## Every function against its floor (generic motion)\n", FLOOR,
+        *(functions(r, v) + "\n" for v in paper(r)),
         "## NumPy against Newton–Euler\n",
         "`evaluate(model, \"inverse_dynamics\", ...)` against `tests/newton_euler.py` on the same "
         "samples (in chunks of 10^5), ns per sample, the best of pyperf's values.\n\n",
@@ -202,11 +275,33 @@ def document(r: dict[str, Any]) -> str:
         "\n## Peers\n",
         ", ".join(peers) + (" from Python.\n" if peers else "MuJoCo not installed.\n"),
     ]  # fmt: skip
+
+
+def structure_parts(r: dict[str, Any]) -> list[str]:
+    """The structures' sections: the compact table, generation's steps, every function."""
+    return [
+        "\n## Every structure\n", structures(r),
+        "\n### Generation, step by step (s)\n",
+        "`import rpr3gen`; finding the variant (cold: deriving and writing it); importing its "
+        "NumPy module; its C library (cold: compiling it); the whole process, interpreter "
+        "included. Cold derives even `rrr_1`, which the package carries.\n\n",
+        generation(r),
+        "\n### Every function against its floor, per structure (generic motion)\n", FLOOR,
+        *("\n" + functions(r, v) for v in r["structures"]),
+    ]  # fmt: skip
+
+
+def document(r: dict[str, Any]) -> str:
+    parts = ["# Benchmark results\n", header(r)]
+    parts += paper_parts(r) if paper(r) else []
+    parts += structure_parts(r) if r.get("structures") else []
     return "".join(parts)
 
 
 def readme_block(r: dict[str, Any]) -> str:
-    return "\n".join([BEGIN, header(r), targets(r), functions(r, "revolute"), control_loop(r), END])
+    every = ["**Every structure**:\n", structures(r)] if r.get("structures") else []
+    return "\n".join([BEGIN, header(r), targets(r), functions(r, "revolute"), control_loop(r),
+                      *every, END])  # fmt: skip
 
 
 def main(argv: Sequence[str] | None = None) -> int:

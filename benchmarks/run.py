@@ -1,13 +1,19 @@
 """Every benchmark of rpr3gen in one command: ``python benchmarks/run.py [--quick] [--readme]``.
 
-Runs, over every variant in ``generated/``: the C per-function harness (``harness/cbench.py``:
-floor, single call, batch), the control-loop examples (``harness/examples.py``: their own tick
-latencies) and the Python benchmarks on pyperf (``harness/pybench.py``, one pyperf run per
-group, fresh worker processes). Writes ``benchmarks/results.json`` (every figure, the machine
-and its load average at the start and the end), then ``report.py`` turns it into
-``benchmarks/results.md`` and, with ``--readme``, README.md's Performance tables. ``--quick``
-(fewer repeats, ~2 minutes) writes ``results-quick.json`` and ``results-quick.md`` instead, so
-that it never replaces the committed full results.
+Runs, over the paper's variants in ``generated/`` (``harness/samples.py``): the C per-function
+harness (``harness/cbench.py``: floor, single call, batch), the control-loop examples
+(``harness/examples.py``: their own tick latencies) and the Python benchmarks on pyperf
+(``harness/pybench.py``, one pyperf run per group, fresh worker processes); and for every one of
+the 18 structures, on its own model: its generation time (``harness/generation.py``: cold and
+cached, fresh interpreters), the same C per-function harness and NumPy per function (pyperf).
+Variants that ``generated/`` lacks are derived into the run's own cache folder (a temporary
+``RPR3GEN_CACHE_DIR``), never the user's. Writes ``benchmarks/results.json`` (every figure, the
+machine and its load average at the start and the end), then ``report.py`` turns it into
+``benchmarks/results.md`` and, with ``--readme``, README.md's Performance tables.
+
+``--quick`` (fewer repeats) and ``--structures rrr_1,prr_1`` (those structures alone, without
+the paper's figures: about a minute a structure with ``--quick``) write ``results-quick.json``
+and ``results-quick.md`` instead, so that they never replace the committed full results.
 """
 
 from __future__ import annotations
@@ -20,6 +26,7 @@ import subprocess
 import sys
 import tempfile
 import time
+from collections.abc import Sequence
 from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
@@ -29,7 +36,7 @@ import pyperf
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import report
-from harness import cbench, examples, samples
+from harness import cbench, examples, generation, samples
 
 BENCH = Path(__file__).resolve().parent
 REPO = BENCH.parent
@@ -38,6 +45,11 @@ PYPERF: dict[str, tuple[list[str], list[str] | None]] = {
     "numpy": (["--processes", "2", "--values", "3"], ["--processes", "1", "--values", "1"]),
     "large": (["--processes", "1", "--values", "2", "--loops", "1"], None),
     "functions": (["--processes", "2", "--values", "3"], ["--processes", "1", "--values", "1"]),
+    # 18 structures x 13 functions: one process each, no calibration (a call takes milliseconds)
+    "structures": (
+        ["--processes", "1", "--values", "3", "--loops", "1"],
+        ["--processes", "1", "--values", "1", "--loops", "1"],
+    ),
     "calls": (["--processes", "3", "--values", "5"], ["--processes", "1", "--values", "3"]),
     "peers": (["--processes", "2", "--values", "3"], ["--processes", "1", "--values", "2"]),
     "regen": (
@@ -77,16 +89,20 @@ def machine() -> dict[str, Any]:
     }
 
 
-def run_pyperf(group: str, quick: bool) -> dict[str, dict[str, float]]:
-    """One pyperf run of a group of ``harness/pybench.py``: median, min (s) and counts."""
+def run_pyperf(
+    group: str, quick: bool, structures: Sequence[str] = ()
+) -> dict[str, dict[str, float]]:
+    """One pyperf run of a group of ``harness/pybench.py``: median, min (s) and counts. Its
+    workers use the run's cache of variants; ``structures``: those of the group ``structures``."""
     options = PYPERF[group][1 if quick else 0]
-    if options is None:
+    if options is None or (group == "structures" and not structures):
         return {}
     with tempfile.TemporaryDirectory(prefix="rpr3bench-pyperf-") as tmp:
         out = Path(tmp) / f"{group}.json"
         subprocess.run(
             [sys.executable, str(BENCH / "harness" / "pybench.py"), group, "--quiet",
-             "--warmups", "1", *options, "-o", str(out)],
+             "--warmups", "1", *options, "--inherit-environ", "RPR3GEN_CACHE_DIR",
+             *(["--structures", ",".join(structures)] if structures else []), "-o", str(out)],
             check=True,
         )  # fmt: skip
         suite = pyperf.BenchmarkSuite.load(str(out))
@@ -107,34 +123,75 @@ def dump(value: Any, indent: str = "") -> str:
 
 
 def results_path(quick: bool) -> Path:
-    """Where a run's results go: ``results.json``, or ``results-quick.json`` (ignored by git) with
-    ``--quick``, so that a quick run never replaces the committed full results."""
+    """Where a run's results go: ``results.json``, or ``results-quick.json`` (ignored by git) for
+    a quick or partial run, so that it never replaces the committed full results."""
     return BENCH / ("results-quick.json" if quick else "results.json")
+
+
+def chosen(text: str) -> tuple[str, ...]:
+    """The structures of ``--structures``: ``all`` or variant names, comma-separated."""
+    known = samples.structures()
+    if text == "all":
+        return known
+    names = tuple(dict.fromkeys(name.strip() for name in text.split(",")))
+    unknown = [name for name in names if name not in known]
+    if unknown:
+        raise argparse.ArgumentTypeError(
+            f"not a structure: {', '.join(unknown)} (they are: all, {', '.join(known)})"
+        )
+    return names
+
+
+def measure(results: dict[str, Any], structures: Sequence[str], quick: bool) -> None:
+    """Every figure into ``results``: the paper's when every structure is measured, then the
+    structures'. The variants come from the cache folder ``$RPR3GEN_CACHE_DIR``."""
+    paper = samples.paper_variants() if tuple(structures) == samples.structures() else ()
+    results.update(paper=list(paper), structures=list(structures), c={}, generation={})
+    n, repeats = (20_000, 3) if quick else (100_000, 9)
+    for variant in paper:
+        for motion in samples.motions(variant):
+            log(f"C functions: {variant}, {motion} motion")
+            results["c"][f"{variant}/{motion}"] = cbench.run(variant, motion, n, repeats)
+    cache = Path(os.environ["RPR3GEN_CACHE_DIR"])
+    for variant in structures:
+        log(f"{variant}: generation (cold, cached), model and motion")
+        results["generation"][variant] = generation.run(variant, keep=cache)
+        results["generation"][variant].update(
+            model=samples.model_source(variant), scale=samples.scale(variant)
+        )
+        log(f"{variant}: C functions")
+        results["c"][f"{variant}/generic"] = cbench.run(variant, "generic", n, repeats)
+    if paper:
+        log("control-loop examples")
+        results["examples"] = examples.run()
+    results["python"] = {}
+    for group in PYPERF if paper else ("structures",):
+        log(f"pyperf: {group}")
+        results["python"].update(run_pyperf(group, quick, structures))
 
 
 def main() -> int:
     parser = argparse.ArgumentParser(description=(__doc__ or "").split("\n", 1)[0])
     parser.add_argument("--quick", action="store_true", help="fewer repeats; results-quick.*")
     parser.add_argument("--readme", action="store_true", help="also README.md's tables")
+    parser.add_argument(
+        "--structures", type=chosen, default="all", metavar="LIST",
+        help="the structures measured: all (the default: a full run) or variant names, "
+             "comma-separated (rrr_1,prr_1: those alone, without the paper's figures)",
+    )  # fmt: skip
     args = parser.parse_args()
+    partial = args.structures != samples.structures()
+    if args.readme and partial:
+        parser.error("--readme needs a run of every structure")
     start = time.monotonic()
     results: dict[str, Any] = {"machine": machine(), "quick": args.quick,
                                "load_start": os.getloadavg()}  # fmt: skip
-    n, repeats = (20_000, 3) if args.quick else (100_000, 9)
-    results["c"] = {}
-    for variant in samples.variants():
-        for motion in samples.MOTIONS:
-            log(f"C functions: {variant}, {motion} motion")
-            results["c"][f"{variant}/{motion}"] = cbench.run(variant, motion, n, repeats)
-    log("control-loop examples")
-    results["examples"] = examples.run()
-    results["python"] = {}
-    for group in PYPERF:
-        log(f"pyperf: {group}")
-        results["python"].update(run_pyperf(group, args.quick))
+    with tempfile.TemporaryDirectory(prefix="rpr3bench-cache-") as cache:
+        os.environ["RPR3GEN_CACHE_DIR"] = cache  # the run's variants and C libraries
+        measure(results, args.structures, args.quick)
     results["load_end"] = os.getloadavg()
     results["seconds"] = round(time.monotonic() - start)
-    out = results_path(args.quick)
+    out = results_path(args.quick or partial)
     out.write_text(dump(results) + "\n")
     log(f"wrote {out.relative_to(REPO)}")
     report.main([str(out), *(["--readme"] if args.readme else [])])

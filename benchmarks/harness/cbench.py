@@ -24,7 +24,7 @@ from pathlib import Path
 from typing import Any
 
 from harness import samples
-from rpr3gen import cbackend, manifest
+from rpr3gen import cbackend
 from rpr3gen.manifest import FunctionInfo
 
 C_DIR = Path(__file__).resolve().parent.parent / "c"
@@ -115,7 +115,7 @@ static size_t batch_{n}(const double *p, const double *const *in, size_t n, doub
 
 def header(variant: str) -> tuple[str, list[str]]:
     """``functions.h`` of a variant and the names of the functions it measures."""
-    found = manifest.load(variant)
+    found = samples.code(variant)
     calls = kernel_calls(found.path("c_source").read_text(), found.prefix)
     names = [n for n, f in found.functions.items() if samples.measurable(found, f)]
     rows = []
@@ -137,8 +137,8 @@ def parse(stdout: str) -> dict[str, dict[str, Any]]:
 
 def run(variant: str, motion: str, n: int, repeats: int) -> dict[str, Any]:
     """Time every measurable function of ``variant`` on ``n`` samples of ``motion``."""
-    found = manifest.load(variant)
-    arrays = samples.motion(motion, n)
+    found = samples.code(variant)
+    arrays = samples.motion(variant, motion, n)
     with tempfile.TemporaryDirectory(prefix="rpr3bench-") as tmp:
         build = Path(tmp)
         text, names = header(variant)

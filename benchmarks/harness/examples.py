@@ -1,9 +1,10 @@
 """The control-loop examples as benchmarks: their own tick latencies (issue 20's figure).
 
 ``examples/control_loop`` is built by its Makefile (its flags, against ``generated/``) into a
-temporary folder, and both programs, C and Python, run every variant the Makefile builds on both
-paper trajectories for 3 s; each prints the latency (p50, p99, max) of its forward kinematics,
-of the rest of the tick and of the whole tick, which are parsed here.
+temporary folder, and both programs, C and Python, run each of the paper's variants (the
+examples drive the paper's robot) on both paper trajectories for 3 s; each prints the latency
+(p50, p99, max) of its forward kinematics, of the rest of the tick and of the whole tick, which
+are parsed here.
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ from pathlib import Path
 from typing import Any
 
 from harness import samples
+from rpr3gen import manifest
 
 EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "control_loop"
 TRAJECTORIES = ("rectilinear", "rotation")
@@ -40,7 +42,7 @@ def run() -> dict[str, Any]:
         work = Path(tmp)
         for name in ("Makefile", "control_loop.c"):
             shutil.copy(EXAMPLE / name, work / name)
-        generated = Path(samples.manifest.default_folder())
+        generated = Path(manifest.default_folder())
         made = subprocess.run(["make", "-s", f"GENERATED={generated}", "-n"], cwd=work,
                               capture_output=True, text=True, check=True)  # fmt: skip
         results["build"] = made.stdout.splitlines()[0] if made.stdout else ""
@@ -48,7 +50,7 @@ def run() -> dict[str, Any]:
         params = subprocess.run([sys.executable, "-m", "rpr3gen.cli", "params"],
                                 capture_output=True, text=True, check=True)  # fmt: skip
         (work / "paper.params").write_text(params.stdout)
-        for variant in samples.variants():
+        for variant in samples.paper_variants():
             binary = work / f"control_loop_{variant}"
             for trajectory in TRAJECTORIES:
                 key = f"{variant}/{trajectory}"

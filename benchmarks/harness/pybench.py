@@ -11,17 +11,20 @@ own repeat counts):
   its (n, 21, 21) systems fit) on the same samples, per variant and motion, at 10^4 and 10^5;
 - ``large``: the same at 10^6 (a call takes seconds: run with ``--loops 1``);
 - ``functions``: ``evaluate(..., backend="numpy")`` of every measurable function at 10^5;
+- ``structures``: the same for the structures named by ``--structures`` (every one by default),
+  each on its own model and generic motion (``harness/samples.py``);
 - ``calls``: ``SampleEvaluator`` single calls (the C through ctypes) of every function, at the
   generic motion's first pose, and the same call with a NaN input (the ctypes floor);
 - ``peers``: MuJoCo's ``mj_forward`` on the same robot (skipped without MuJoCo);
 - ``regen``: ``rpr3gen generate --check``, a fresh interpreter end to end.
 
-Benchmark names are ``group/variant/...`` (see :func:`names`); ``benchmarks/run.py`` reads them.
+The groups but ``structures`` measure the paper's variants. Benchmark names are
+``group/variant/...`` (see :func:`names`; ``structures`` names its own ``functions/...``);
+``benchmarks/run.py`` reads them.
 """
 
 from __future__ import annotations
 
-import importlib.util
 import math
 import sys
 import time
@@ -35,25 +38,11 @@ import pyperf
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 import rpr3gen
 from harness import samples
-from rpr3gen import manifest
+from harness.samples import test_module
 
-REPO = Path(__file__).resolve().parents[2]
 SIZES = {"numpy": (10**4, 10**5), "large": (10**6,)}
 NE_CHUNK = 10**5
-GROUPS = ("numpy", "large", "functions", "calls", "peers", "regen")
-
-
-def test_module(name: str) -> Any:
-    """``tests/NAME.py``, imported by path (the tests are no package)."""
-    spec = importlib.util.spec_from_file_location(
-        f"rpr3bench_{name}", REPO / "tests" / f"{name}.py"
-    )
-    assert spec is not None
-    assert spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module  # dataclasses look their module up
-    spec.loader.exec_module(module)
-    return module
+GROUPS = ("numpy", "large", "functions", "structures", "calls", "peers", "regen")
 
 
 def timed(setup: Callable[[], Callable[[], object]]) -> Callable[[int], float]:
@@ -80,13 +69,13 @@ def numpy_benchmarks(variant: str, sizes: tuple[int, ...]) -> dict[str, Callable
         for n in sizes:
 
             def ours(motion: str = motion, n: int = n) -> Callable[[], object]:
-                a = samples.motion(motion, n)
+                a = samples.motion(variant, motion, n)
                 return lambda: rpr3gen.evaluate(
                     model, "inverse_dynamics", [a["q"], a["qd"], a["qdd"]]
                 )
 
             def reference(motion: str = motion, n: int = n) -> Callable[[], object]:
-                a = samples.motion(motion, n)
+                a = samples.motion(variant, motion, n)
                 params = dict(model.params)
 
                 def solve() -> None:
@@ -102,15 +91,15 @@ def numpy_benchmarks(variant: str, sizes: tuple[int, ...]) -> dict[str, Callable
 
 
 def function_benchmarks(variant: str) -> dict[str, Callable[[int], float]]:
-    found_variant = manifest.load(variant)
-    model = samples.model(variant)
+    found_variant = samples.code(variant)
     found: dict[str, Callable[[int], float]] = {}
     for name, f in found_variant.functions.items():
         if not samples.measurable(found_variant, f):
             continue
 
         def setup(f: Any = f) -> Callable[[], object]:
-            inputs = samples.inputs(variant, f, samples.motion("generic", 10**5))
+            model = samples.model(variant)
+            inputs = samples.inputs(variant, f, samples.motion(variant, "generic", 10**5))
             return lambda: rpr3gen.evaluate(model, f.name, inputs, backend="numpy")
 
         found[f"functions/{variant}/{name}"] = timed(setup)
@@ -118,9 +107,9 @@ def function_benchmarks(variant: str) -> dict[str, Callable[[int], float]]:
 
 
 def call_benchmarks(variant: str) -> dict[str, Callable[[int], float]]:
-    found_variant = manifest.load(variant)
+    found_variant = samples.code(variant)
     model = samples.model(variant)
-    pose = samples.motion("generic", 3001)  # 1 ms apart, as a control loop's ticks
+    pose = samples.motion(variant, "generic", 3001)  # 1 ms apart, as a control loop's ticks
     found: dict[str, Callable[[int], float]] = {}
     for name, f in found_variant.functions.items():
         if not all(a.name in samples.MOTION_INPUTS or a.name in ("qa", "q_near", "tau", "qa_dot")
@@ -167,10 +156,13 @@ def peer_benchmarks(variant: str) -> dict[str, Callable[[int], float]]:
     return {f"peers/{variant}/mj_forward": timed(setup)}
 
 
-def names(group: str) -> dict[str, Callable[[int], float]]:
-    """Every benchmark of ``group``, by name, over the variants found in ``generated/``."""
+def names(group: str, structures: tuple[str, ...] = ()) -> dict[str, Callable[[int], float]]:
+    """Every benchmark of ``group``, by name: over the paper's variants in ``generated/``, or
+    (``structures``) over the variants ``structures``."""
+    if group == "structures":
+        return {k: v for s in structures for k, v in function_benchmarks(s).items()}
     found: dict[str, Callable[[int], float]] = {}
-    for variant in samples.variants():
+    for variant in samples.paper_variants():
         if group in SIZES:
             found.update(numpy_benchmarks(variant, SIZES[group]))
         else:
@@ -181,20 +173,24 @@ def names(group: str) -> dict[str, Callable[[int], float]]:
 
 
 def add_group(cmd: list[str], args: Any) -> None:
-    """Forward the group to pyperf's worker processes."""
-    cmd.append(args.group)
+    """Forward the group and the structures to pyperf's worker processes."""
+    cmd += [args.group, "--structures", args.structures]
 
 
 def main() -> None:
     runner = pyperf.Runner(add_cmdline_args=add_group)
     runner.argparser.add_argument("group", choices=GROUPS)
+    runner.argparser.add_argument(
+        "--structures", default=",".join(samples.structures()),
+        help="the group structures: these variants (comma-separated)",
+    )  # fmt: skip
     args = runner.parse_args()
     if args.group == "regen":
         runner.bench_command(
             "regen/generate_check", [sys.executable, "-m", "rpr3gen.cli", "generate", "--check"]
         )
         return
-    for name, func in names(args.group).items():
+    for name, func in names(args.group, tuple(args.structures.split(","))).items():
         runner.bench_time_func(name, func)
     np.seterr(all="ignore")
 
