@@ -90,3 +90,20 @@ def test_the_peak_effort_scale_ends_at_the_95th_percentile() -> None:
     share = np.count_nonzero(efforts > top) / efforts.size
     label = f"above the scale: {top:,.0f} to {efforts.max():,.0f} N·m ({share:.1%} of the points)"
     assert label in [t.get_text() for t in legend.get_texts()]
+
+
+def test_a_map_without_a_long_tail_keeps_its_whole_scale(repo_root: Path) -> None:
+    """The 3-RRR of the gallery has no parallel singularity at phi = 0: its largest effort is
+    about twice the 95th percentile, and the scale spans every point, nothing drawn over."""
+    from rpr3gen.design import figures
+
+    wmap = rpr3gen.workspace(rpr3gen.load_model(repo_root / "models" / "rrr.toml"), 0.0, 40)
+    peak = np.max(np.abs(wmap.tau), axis=2)
+    efforts = peak[np.isfinite(peak) & (peak > 0)]
+    assert efforts.max() < figures.CLIP_RATIO * np.percentile(efforts, 95)
+    fig = figures.effort_figure(wmap)
+    (image,) = fig.axes[0].get_images()
+    assert (image.norm.vmin, image.norm.vmax) == (efforts.min(), efforts.max())
+    assert fig.axes[1].get_ylabel().endswith("(log scale)")
+    (legend,) = fig.legends
+    assert not any("above the scale" in t.get_text() for t in legend.get_texts())

@@ -41,7 +41,12 @@ LEG_COLORS = {"A": "tab:blue", "B": "tab:orange", "C": "tab:green"}
 
 
 CLIP_PERCENTILE = 95.0
-"""The peak-effort map's colour scale ends at this percentile of the reachable points' efforts."""
+"""The peak-effort map's colour scale ends at this percentile of the reachable points' efforts
+(when the tail above it is long: :data:`CLIP_RATIO`)."""
+
+CLIP_RATIO = 10.0
+"""The scale is clipped only when the largest effort exceeds the percentile this many times (a
+parallel singularity nearby); else it spans every point."""
 
 OVER_COLOR = "#33b5e5"
 """Colour of the points above the peak-effort map's colour scale (not in its colour map)."""
@@ -207,10 +212,11 @@ def effort_figure(wmap: WorkspaceMap) -> Figure:
 
     Loads grow as 1/conditioning towards a parallel singularity, so the few points just above
     the conditioning floor reach efforts orders of magnitude above the rest (24,658 N·m on the
-    paper robot, 37 N·m at the median). The colour scale (log) ends at the
-    :data:`CLIP_PERCENTILE` th percentile of the reachable points' efforts; the points above it
-    are drawn in :data:`OVER_COLOR`, and the legend says where the scale ends and up to what
-    the points above it go.
+    paper robot, 37 N·m at the median). The colour scale (log) then ends at the
+    :data:`CLIP_PERCENTILE` th percentile of the reachable points' efforts, when the largest
+    exceeds it :data:`CLIP_RATIO` times; the points above it are drawn in :data:`OVER_COLOR`,
+    and the legend says where the scale ends and up to what the points above it go. A map
+    without such a tail (the gallery's 3-RRR: 20 N·m at most) keeps its whole range.
     """
     unit = wmap.effort_unit
     fig, ax = _frame(wmap, f"Peak static effort max |{wmap.effort}| over legs A, B, C")
@@ -220,7 +226,7 @@ def effort_figure(wmap: WorkspaceMap) -> Figure:
     if finite.size:
         low, high = float(finite.min()), float(finite.max())
         top = float(np.percentile(finite, CLIP_PERCENTILE))
-        clipped = low < top < high
+        clipped = low < top and high > CLIP_RATIO * top
         cmap = colormaps["magma"].with_extremes(over=OVER_COLOR)
         norm = LogNorm(vmin=low, vmax=top if clipped else high)
         image = _image(ax, wmap, np.where(peak > 0, peak, np.nan), cmap=cmap, norm=norm)
