@@ -64,7 +64,7 @@ from rpr3gen.errors import (
     Rpr3genError,
     TrajectoryError,
 )
-from rpr3gen.identification import Fit, inertial_parameters
+from rpr3gen.identification import MAX_WEIGHT_RATIO, Fit, inertial_parameters
 from rpr3gen.model import ACTUATIONS, Model
 from rpr3gen.structure import Structure
 
@@ -515,6 +515,23 @@ NAME = Kind(
 MOTION3 = (("q", "qd", "qdd"),)
 
 
+def _weights() -> Kind:
+    """identify's weights: a positive reading whose largest is at most MAX_WEIGHT_RATIO times
+    its smallest (Hypothesis found (1, 1, 1e154): the standard deviations overflowed)."""
+    base = reading(3, positive=True)
+
+    def classify(value: Any) -> str | None:
+        verdict = base.classify(value)
+        if verdict == "ok":
+            a = np.asarray(value, dtype=float)
+            return "value" if a.max() > MAX_WEIGHT_RATIO * a.min() else "ok"
+        return verdict
+
+    return dataclasses.replace(
+        base, classify=classify, bad_values=(*base.bad_values, [1.0, 1.0, 1e154])
+    )
+
+
 def _api(name: str, **fields: Any) -> Api:
     call = fields.pop("call", None) or getattr(rpr3gen, name)
     return Api(name=name, call=call, **fields)
@@ -692,7 +709,7 @@ def apis(s: Scene) -> tuple[Api, ...]:
                 "tau": MOTION,
                 "friction": flag(),
                 "identical_legs": identical_legs,
-                "weights": optional(reading(3, positive=True)),
+                "weights": optional(_weights()),
                 "max_condition": number(greater=1.0, finite=False, good=(1e3, math.inf)),
                 "t": optional(TIMES),
                 "backend": backend,

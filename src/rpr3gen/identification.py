@@ -36,9 +36,14 @@ from rpr3gen.identifiability import MAX_CONDITION, WARN_CONDITION, Assessment, a
 from rpr3gen.model import LEGS, Model
 from rpr3gen.validation import Number, Optional, Reading, Rows, Sample, checked
 
+MAX_WEIGHT_RATIO = 1e6
+"""The largest ratio of two actuators' weights :func:`identify` takes: beyond it the least
+weighted rows are below the others' rounding error, and the standard deviations overflow."""
+
 __all__ = [
     "INERTIAL_PARAMETER_NAMES",
     "MAX_CONDITION",
+    "MAX_WEIGHT_RATIO",
     "SHARED_PARAMETER_NAMES",
     "WARN_CONDITION",
     "BaseParameters",
@@ -571,7 +576,7 @@ def identify(
         friction: also estimate viscous and Coulomb friction per actuator.
         identical_legs: the legs share one set of parameters (B = 9 instead of 19).
         weights: (3,) the weight of each actuator's rows instead of the automatic ones
-            (positive; only their ratios count).
+            (positive; only their ratios count, at most :data:`MAX_WEIGHT_RATIO`).
         warn_condition: above this condition number the fit warns (default
             :data:`WARN_CONDITION`, 1e3; :mod:`rpr3gen.identifiability` says why).
         max_condition: the largest condition number accepted (default :data:`MAX_CONDITION`,
@@ -640,6 +645,13 @@ def identify(
     else:
         w = np.asarray(weights)  # (3,), positive and finite: checked
         w = w / w.max()  # only their ratios count; so none overflows the weighted rows
+        if w.min() < 1.0 / MAX_WEIGHT_RATIO:
+            raise InputError(
+                f"weights: the largest is more than {MAX_WEIGHT_RATIO:g} times the smallest "
+                f"({np.asarray(weights).tolist()}): the rows of the least weighted actuator "
+                "would count for nothing (leave its samples out instead)",
+                argument="weights",
+            )
     x, W, y = solve(w)
     weighted = y - W @ x
     sigma2 = float(weighted @ weighted) / (3 * n - p)
