@@ -7,6 +7,6 @@ Two halves, one way only:
 
 - ``codegen/``: a generic engine (programs, specs, CSE, one backend per language with its
   printer and templates, rendering, regeneration check) that imports nothing of the robot;
-- ``rpr3/``: the 3-RPR robot (symbols → frames → kinematics → dynamics → virtual work), its
-  registry of function specs, and ``generate``, which runs the engine on them.
+- ``planar/``: any planar 3-leg robot (legs → kinematics → dynamics → virtual work), its
+  ``registry/`` of function specs, and ``generate``, which runs the engine on them.
 """

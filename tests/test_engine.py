@@ -17,6 +17,7 @@ from rpr3gen_derive.codegen import Check, Component, FunctionSpec, Output, Progr
 from rpr3gen_derive.codegen.files import write_files
 from rpr3gen_derive.planar import generate, paper, registry, structures
 from rpr3gen_derive.planar import symbols as syms
+from rpr3gen_derive.planar.registry.arguments import POSE
 
 import rpr3gen
 from rpr3gen import manifest
@@ -41,7 +42,7 @@ def leg_lengths(structure: structures.Structure) -> FunctionSpec:
     return FunctionSpec(
         name="leg_lengths",
         doc="Leg lengths |A1 A3| at the platform pose q (toy function of the engine's test).",
-        inputs=(registry.POSE,),
+        inputs=(POSE,),
         outputs=(
             Output(
                 "lengths",

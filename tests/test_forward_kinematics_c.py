@@ -21,7 +21,9 @@ import fk_reference as fk
 import newton_euler as ne
 import numpy as np
 import pytest
+from rpr3gen_derive.codegen.spec import FunctionSpec
 from rpr3gen_derive.planar import generate, paper, registry, structures
+from rpr3gen_derive.planar.registry import direct_kinematics as dk_specs
 
 import rpr3gen
 from rpr3gen.model import Model
@@ -83,8 +85,8 @@ Traced = Callable[[dict, np.ndarray, np.ndarray], tuple[int, np.ndarray, int, st
 
 
 def _build(folder: Path, actuation: str, **context: object) -> ctypes.CDLL:
-    def builder(structure: structures.Structure) -> registry.FunctionSpec:
-        spec = registry.forward_kinematics(structure)
+    def builder(structure: structures.Structure) -> FunctionSpec:
+        spec = dk_specs.forward_kinematics(structure)
         values = {**dict(spec.c_context), "trace": True, **context}
         return dataclasses.replace(spec, c_context=tuple(values.items()))
 

@@ -32,6 +32,7 @@ from rpr3gen_derive.codegen.program import Program
 from rpr3gen_derive.planar import control, direct_kinematics, general, identification, registry
 from rpr3gen_derive.planar import structures as st
 from rpr3gen_derive.planar import symbols as syms
+from rpr3gen_derive.planar.registry.direct_kinematics import ANGLE
 
 try:
     from . import planar_checks as chk
@@ -302,7 +303,7 @@ def _direct_kinematics(kinds: str, actuated: int):
     if kind == "circle":
         prog = Program()
         sextic = compile_program(prog, inputs, direct_kinematics.sextic_coefficients(prog, holds))
-        cs = list(registry.ANGLE.symbols)
+        cs = list(ANGLE.symbols)
         prog2 = Program()
         xy = direct_kinematics.pose_from_angle(prog2, holds, *cs)
         back = compile_program(prog2, [*inputs, *cs], list(xy))

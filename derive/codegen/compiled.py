@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import sympy as sp
 from rpr3gen_derive.codegen.cse import StraightLine, straight_line
-from rpr3gen_derive.codegen.spec import Argument, FunctionSpec
+from rpr3gen_derive.codegen.spec import Argument, FunctionSpec, ModuleSpec, Output
 
 Stage = Callable[[str], AbstractContextManager[object]]
 
@@ -68,3 +68,17 @@ def compile_function(spec: FunctionSpec, params: Argument) -> Compiled:
         ),
         slots=tuple((o, k) for o, k, _ in flat),
     )
+
+
+def name_tables(
+    module: ModuleSpec, compiled: list[Compiled]
+) -> list[tuple[str, Argument | Output]]:
+    """Every name table of a module with its count macro's suffix: the parameters', the extra
+    tables, then those of the functions' outputs."""
+    tables: list[tuple[str, Argument | Output]] = [
+        (table_count(module.params.table or "param_names"), module.params)
+    ]
+    tables += [(table_count(str(t.table)), t) for t in module.tables]
+    for c in compiled:
+        tables += [(table_count(o.table), o) for o in c.spec.outputs if o.table]
+    return tables

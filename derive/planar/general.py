@@ -22,6 +22,7 @@ from __future__ import annotations
 import sympy as sp
 from rpr3gen_derive.planar.geometry import (
     LEGS,
+    SHARED_PARAM_DOCS,
     LegGeometry,
     PlatformGeometry,
     Reference,
@@ -59,15 +60,10 @@ def param_symbol(name: str) -> sp.Symbol:
 def param_doc(name: str) -> tuple[str, str]:
     """Unit and meaning of a parameter."""
     fixed = {
-        "m3": ("kg", "platform mass"),
         "cx3": ("m", "platform centre of mass, platform frame x"),
         "cy3": ("m", "platform centre of mass, platform frame y"),
         "J3": ("kg m^2", "platform inertia about its centre of mass, axis z"),
-        "gx": ("m/s^2", "gravity, world x0"),
-        "gy": ("m/s^2", "gravity, world y0 (up)"),
-        "fx": ("N", "payload force on the platform at G, x0"),
-        "fy": ("N", "payload force on the platform at G, y0"),
-        "mz": ("N m", "payload moment on the platform, about z0"),
+        **SHARED_PARAM_DOCS,
     }
     if name in fixed:
         return fixed[name]

@@ -136,6 +136,18 @@ class Robot:
     names: JointNames = GENERAL_NAMES
 
 
+#: Unit and meaning of the parameters every parametrisation shares: the platform's mass, gravity
+#: and the payload (docs/interfaces.md).
+SHARED_PARAM_DOCS: dict[str, tuple[str, str]] = {
+    "m3": ("kg", "platform mass"),
+    "gx": ("m/s^2", "gravity, world x0"),
+    "gy": ("m/s^2", "gravity, world y0 (up)"),
+    "fx": ("N", "payload force on the platform at G, x0"),
+    "fy": ("N", "payload force on the platform at G, y0"),
+    "mz": ("N m", "payload moment on the platform, about z0"),
+}
+
+
 STEP_CONSTANTS = "the model's constants: body coordinates of points, from the parameters"
 
 

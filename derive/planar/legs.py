@@ -133,6 +133,17 @@ def in_frame(e: Vec, v: Vec) -> Vec:
 X0: Vec = (sp.Integer(1), sp.Integer(0))
 
 
+def _slide_to_circle(
+    leg: _Leg, w: Vec, y: Vec, radius2: sp.Expr
+) -> tuple[sp.Expr, sp.Expr, sp.Expr]:
+    """The slide ``q`` along the unit ``w`` with ``|y - q w|^2 = radius2``, in the working mode:
+    ``(t, k, D)``, ``(t, k)`` the coordinates of ``y`` in the frame ``(w, perp(w))``,
+    ``D = sigma sqrt(radius2 - k^2)`` and ``q = t - D`` (RRP and PRR)."""
+    t, k = (leg.define("t", dot(w, y)), leg.define("k", cross(w, y)))
+    D = leg.define("D", leg.g.sigma * sp.sqrt(radius2 - k**2))
+    return t, k, D
+
+
 def _two_links(leg: _Leg, platform: Platform, x3: Vec) -> LegPose:
     """RRR: joint 2's point is where the circles about joint 1 and about X3 meet (the leg frame
     is the world's)."""
@@ -190,8 +201,7 @@ def _rrp(leg: _Leg, platform: Platform, x3: Vec) -> LegPose:
     a23, b23 = g.links[1]
     w3 = leg.vector("w3", platform.turn(g.axis(3)))
     y = sub(sub(x3, g.points[0]), along((a23, b23), w3))
-    t, k = (leg.define("t", dot(w3, y)), leg.define("k", cross(w3, y)))
-    D = leg.define("D", g.sigma * sp.sqrt(h1.length2 - k**2))
+    t, k, D = _slide_to_circle(leg, w3, y, h1.length2)
     q3 = leg.coordinate(3, t - D)
     c1 = (D, k)  # X2 - X1 = y - q3 w3 in the frame
     q1 = leg.coordinate(1, leg.angle(h1, along(c1, w3)))
@@ -207,8 +217,7 @@ def _prr(leg: _Leg, platform: Platform, x3: Vec) -> LegPose:
     h2 = g.references[1]
     u1 = g.axis(1)
     y = sub(x3, g.points[1])
-    t, k = (leg.define("t", dot(u1, y)), leg.define("k", cross(u1, y)))
-    D = leg.define("D", g.sigma * sp.sqrt(h2.length2 - k**2))
+    t, k, D = _slide_to_circle(leg, u1, y, h2.length2)
     q1 = leg.coordinate(1, t - D)
     c2 = (D, k)  # X3 - X2 = y - q1 u1 in the frame
     q2 = leg.coordinate(2, leg.angle(h2, along(c2, u1)))

@@ -20,6 +20,7 @@ from __future__ import annotations
 import sympy as sp
 from rpr3gen_derive.planar.geometry import (
     LEGS,
+    SHARED_PARAM_DOCS,
     JointNames,
     LegGeometry,
     PlatformGeometry,
@@ -64,15 +65,10 @@ def param_doc(name: str) -> tuple[str, str]:
         "c2_perp": ("m", "piston centre of mass off the leg axis: A2 + c2 e + c2_perp n"),
         "m1": ("kg", "cylinder mass"),
         "m2": ("kg", "piston mass"),
-        "m3": ("kg", "platform mass"),
         "J1": ("kg m^2", "cylinder inertia about its centre of mass, axis z"),
         "J2": ("kg m^2", "piston inertia about its centre of mass, axis z"),
         "J3": ("kg m^2", "platform inertia about G, axis z"),
-        "gx": ("m/s^2", "gravity, world x0"),
-        "gy": ("m/s^2", "gravity, world y0 (up)"),
-        "fx": ("N", "payload force on the platform at G, x0"),
-        "fy": ("N", "payload force on the platform at G, y0"),
-        "mz": ("N m", "payload moment on the platform, about z0"),
+        **SHARED_PARAM_DOCS,
     }
     if name in fixed:
         return fixed[name]

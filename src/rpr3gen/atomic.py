@@ -61,20 +61,10 @@ def atomic_write(path: str | os.PathLike[str], mode: str = "w", **kw: Any) -> It
             os.close(fd)  # open() may already have closed it
         os.unlink(tmp)
         raise
-    try:
-        with f:
-            yield f
-            f.flush()
-            os.fsync(f.fileno())
-        os.chmod(tmp, _mode_for(target))
-        os.replace(tmp, target)
-    except BaseException as exc:
-        with contextlib.suppress(OSError):
-            os.unlink(tmp)
-        if isinstance(exc, OSError) and exc.filename in (None, tmp):
-            raise _about(exc, path) from exc
-        raise
-    _fsync_folder(folder)
+    with _replacing(tmp, target, path), f:
+        yield f
+        f.flush()
+        os.fsync(f.fileno())
 
 
 @contextlib.contextmanager
@@ -99,8 +89,17 @@ def atomic_path(path: str | os.PathLike[str]) -> Iterator[str]:
         os.close(fd)
     except OSError as exc:
         raise _about(exc, path) from exc
-    try:
+    with _replacing(tmp, target, path):
         yield tmp
+
+
+@contextlib.contextmanager
+def _replacing(tmp: str, target: str, path: str | os.PathLike[str]) -> Iterator[None]:
+    """Rename ``tmp`` over ``target`` (with :func:`atomic_write`'s permission bits, then the
+    folder synced) when the block succeeds; on any failure remove it, an ``OSError`` about
+    ``tmp`` reported about ``path``."""
+    try:
+        yield
         os.chmod(tmp, _mode_for(target))
         os.replace(tmp, target)
     except BaseException as exc:
@@ -109,7 +108,7 @@ def atomic_path(path: str | os.PathLike[str]) -> Iterator[str]:
         if isinstance(exc, OSError) and exc.filename in (None, tmp):
             raise _about(exc, path) from exc
         raise
-    _fsync_folder(folder)
+    _fsync_folder(os.path.dirname(target))
 
 
 def _about(exc: OSError, path: str | os.PathLike[str]) -> OSError:

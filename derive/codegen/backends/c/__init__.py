@@ -20,7 +20,7 @@ from rpr3gen_derive.codegen.backends.c import package
 from rpr3gen_derive.codegen.backends.c.batch import NotSplittableError, plan
 from rpr3gen_derive.codegen.backends.c.order import Line, schedule
 from rpr3gen_derive.codegen.backends.c.printer import c_code, fast_trig_arguments
-from rpr3gen_derive.codegen.compiled import table_count
+from rpr3gen_derive.codegen.compiled import name_tables, table_count
 from rpr3gen_derive.codegen.spec import ModuleSpec
 
 if TYPE_CHECKING:
@@ -207,10 +207,7 @@ def render(
     with stage("print"):
         values = {name for c in compiled for name in c.spec.c_values}
         functions = [_function(module, c, c.spec.name in values) for c in compiled]
-    tables = [(table_count(module.params.table or "param_names"), module.params)]
-    tables += [(table_count(str(t.table)), t) for t in module.tables]
-    for c in compiled:
-        tables += [(table_count(o.table), o) for o in c.spec.outputs if o.table]
+    tables = name_tables(module, compiled)
     uses_finite = any(f["input_code"] or f["checks"] for f in functions)
     kernels = mathkernels.used(
         e for c in compiled for e in [rhs for _, rhs in c.code.assignments + c.code.outputs]

@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING
 import jinja2
 from rpr3gen_derive.codegen import mathkernels
 from rpr3gen_derive.codegen.backends.python.lowering import lower_numpy
-from rpr3gen_derive.codegen.compiled import table_count
+from rpr3gen_derive.codegen.compiled import name_tables, table_count
 from rpr3gen_derive.codegen.spec import ModuleSpec
 
 if TYPE_CHECKING:
@@ -50,10 +50,7 @@ def render(
                     },
                 }
             )
-    tables = [(table_count(module.params.table or "param_names"), module.params)]
-    tables += [(table_count(str(t.table)), t) for t in module.tables]
-    for c in compiled:
-        tables += [(table_count(o.table), o) for o in c.spec.outputs if o.table]
+    tables = name_tables(module, compiled)
     with stage("render"):
         text = env.get_template("backends/python/templates/module.py.jinja").render(
             module=module,

@@ -1,0 +1,167 @@
+"""The functions of the control model: actuator coordinates (eq. 5), the actuator Jacobian and
+its rate (eqs. 6, 9), the velocity map backwards, the actuator efforts, the task-space and the
+forward dynamics (docs/control-model.md)."""
+
+from __future__ import annotations
+
+import sympy as sp
+from rpr3gen_derive.codegen.program import Program
+from rpr3gen_derive.codegen.spec import Argument, Component, FunctionSpec
+from rpr3gen_derive.planar import control
+from rpr3gen_derive.planar import symbols as syms
+from rpr3gen_derive.planar.registry.arguments import (
+    ACCELERATION,
+    POSE,
+    VELOCITY,
+    actuator_argument,
+    coordinate_unit,
+    effort_argument,
+    matrix_output,
+    output_like,
+    pose_checks,
+    vector_output,
+)
+from rpr3gen_derive.planar.structures import Structure
+
+
+def actuator_coordinates(structure: Structure) -> FunctionSpec:
+    """``rpr3_actuator_coordinates``: ``qa`` of a pose, the inverse kinematics of eq. (5)."""
+    prog = Program()
+    values = sp.Matrix(control.actuator_values(prog, structure, "q"))
+    qa = actuator_argument(structure)
+    return FunctionSpec(
+        name="actuator_coordinates",
+        doc=f"Actuator coordinates qa ({qa.doc}) of the platform pose q, in each leg's working "
+        "mode (eq. 5).",
+        inputs=(POSE,),
+        outputs=(output_like("qa", values, qa, qa.doc),),
+        program=prog,
+        checks=pose_checks(prog, structure),
+    )
+
+
+def actuator_jacobian(structure: Structure) -> FunctionSpec:
+    """``rpr3_actuator_jacobian``: ``J = d qa / d q``, row-major, so that ``qa' = J q'``."""
+    prog = Program()
+    J = control.actuator_jacobian(prog, structure)
+    units = ("1/m", "1/m", "1") if structure.actuated_kind == "R" else ("1", "1", "m")
+    qa_names = [c.name for c in actuator_argument(structure).components]
+    return FunctionSpec(
+        name="actuator_jacobian",
+        doc="Actuator Jacobian J = d qa / d q (eq. 6 differentiated), row-major, one row per "
+        "leg A, B, C: qa' = J q'. det J = 0 at a parallel singularity.",
+        inputs=(POSE,),
+        outputs=(
+            matrix_output(
+                "J",
+                J,
+                units,
+                "J = d qa / d q, row-major",
+                lambda i, j: f"d {qa_names[i]} / d {POSE.components[j].name}",
+            ),
+        ),
+        program=prog,
+        checks=pose_checks(prog, structure),
+    )
+
+
+def jacobian_rate(structure: Structure) -> FunctionSpec:
+    """``rpr3_jacobian_rate``: ``J' q'``, so that ``qa'' = J q'' + J' q'`` (eq. 9)."""
+    prog = Program()
+    rate = control.jacobian_rate_term(prog, structure)
+    qa = actuator_argument(structure)
+    return FunctionSpec(
+        name="jacobian_rate",
+        doc="J' q': the actuator accelerations at zero platform acceleration (eq. 9), so that "
+        "qa'' = J q'' + J' q'.",
+        inputs=(POSE, VELOCITY),
+        outputs=(
+            vector_output(
+                "Jdqd",
+                rate,
+                tuple(f"dd{c.name}" for c in qa.components),
+                (f"{coordinate_unit(structure)}/s^2",) * 3,
+                "J' q'",
+            ),
+        ),
+        program=prog,
+        checks=pose_checks(prog, structure),
+    )
+
+
+def platform_velocity(structure: Structure) -> FunctionSpec:
+    """``rpr3_platform_velocity``: ``q' = J^-1 qa'``, the velocity map backwards."""
+    prog = Program()
+    qd = control.platform_velocity(prog, structure)
+    qa = actuator_argument(structure)
+    rates = Argument(
+        "qa_dot",
+        tuple(syms.qa_dot),
+        tuple(Component(f"d{c.name}", f"{c.unit}/s", f"rate of {c.name}") for c in qa.components),
+        "actuator rates",
+    )
+    return FunctionSpec(
+        name="platform_velocity",
+        doc="Platform velocity q' = J^-1 qa' from the actuator rates (a generated 3 x 3 solve by "
+        "cofactors): the velocity a controller reconstructs from its encoders.",
+        inputs=(POSE, rates),
+        outputs=(output_like("qd", qd, VELOCITY, "platform velocity"),),
+        program=prog,
+        checks=pose_checks(prog, structure),
+    )
+
+
+def actuator_efforts(structure: Structure) -> FunctionSpec:
+    """``rpr3_actuator_efforts``: the actuator efforts alone of the inverse dynamics."""
+    prog = Program()
+    values = sp.Matrix(control.actuator_efforts(prog, structure))
+    tau = effort_argument(structure)
+    return FunctionSpec(
+        name="actuator_efforts",
+        doc=f"Actuator efforts ({tau.doc}) that produce the platform acceleration qdd at "
+        "(q, qd): the inverse dynamics' actuator loads (eqs. 12-17) alone, which is also "
+        "tau = J^-T (M qdd + c), the computed-torque law's efforts for a commanded qdd.",
+        inputs=(POSE, VELOCITY, ACCELERATION),
+        outputs=(output_like("tau", values, tau, "actuator efforts"),),
+        program=prog,
+        checks=pose_checks(prog, structure),
+    )
+
+
+def task_space_dynamics(structure: Structure) -> FunctionSpec:
+    """``rpr3_task_space_dynamics``: ``M`` (row-major) and ``c`` with ``M q'' + c = J^T tau``."""
+    prog = Program()
+    M, c = control.task_space_dynamics(prog, structure)
+    return FunctionSpec(
+        name="task_space_dynamics",
+        doc="Dynamics in control form, M q'' + c = J^T tau, from the virtual work of the "
+        "required wrenches of eqs. (10)-(17): M (row-major, symmetric positive definite) and c "
+        "(Coriolis and centripetal terms, gravity, payload).",
+        inputs=(POSE, VELOCITY),
+        outputs=(
+            matrix_output(
+                "M",
+                M,
+                ("kg", "kg", "kg m", "kg", "kg", "kg m", "kg m", "kg m", "kg m^2"),
+                "mass matrix in platform coordinates, row-major",
+            ),
+            vector_output("c", c, ("c_x", "c_y", "c_phi"), ("N", "N", "N m"), "bias forces"),
+        ),
+        program=prog,
+        checks=pose_checks(prog, structure),
+    )
+
+
+def forward_dynamics(structure: Structure) -> FunctionSpec:
+    """``rpr3_forward_dynamics``: ``q'' = M^-1 (J^T tau - c)``, by an LDL^T solve."""
+    prog = Program()
+    qdd = control.forward_dynamics(prog, structure)
+    return FunctionSpec(
+        name="forward_dynamics",
+        doc="Forward dynamics: the platform acceleration q'' = M^-1 (J^T tau - c) under the "
+        "actuator efforts tau, by an explicit LDL^T solve of the task-space dynamics.",
+        inputs=(POSE, VELOCITY, effort_argument(structure)),
+        outputs=(output_like("qdd", qdd, ACCELERATION, "platform acceleration"),),
+        program=prog,
+        checks=pose_checks(prog, structure),
+    )
