@@ -80,7 +80,7 @@ WMAP = rpr3gen.workspace(MODEL, 0.0, 2)
 EVALUATOR = rpr3gen.SampleEvaluator(MODEL, backend="numpy")
 T6 = np.linspace(0.0, 0.5, 6)
 Q6 = np.column_stack([0.01 * T6, -0.01 * T6, 0.1 * T6])
-PAPER_TOML = Path(rpr3gen.model.__file__).parent / "models" / "paper.toml"
+PAPER_TOML = Path(rpr3gen.__file__).parent / "models" / "paper.toml"
 
 
 def _paper_copy(tmp: Path) -> str:
