@@ -6,11 +6,14 @@ from __future__ import annotations
 
 import ast
 import functools
+import re
 import subprocess
 import sys
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+
+import pytest
 
 BLOCKER = """
 import sys
@@ -275,3 +278,69 @@ def test_the_graph_is_read() -> None:
     assert [[str(e) for e in c] for c in _cycles(sample)] == [
         ["a.py:1: a imports b", "b.py:2: b imports c", "c.py:3: c imports a"]
     ]
+
+
+# -- docs/architecture.md names every package, top folder and command -----------------------------
+
+ARCHITECTURE = ROOT / "docs" / "architecture.md"
+
+
+def _packages() -> list[tuple[str, str]]:
+    """Each package folder of the runtime and the derivation: (its path, its dotted name)."""
+    found = []
+    for package, root in PACKAGES.items():
+        if package == "rpr3gen_generated":  # one folder per variant, described as a whole
+            continue
+        for init in sorted(root.rglob("__init__.py")):
+            folder = init.parent
+            if "__pycache__" not in folder.parts and folder != root:
+                dotted = ".".join([package, *folder.relative_to(root).parts])
+                found.append((folder.relative_to(ROOT).as_posix(), dotted))
+    return found
+
+
+def _top_folders() -> list[str]:
+    """The repository's tracked top folders (hidden ones aside)."""
+    result = subprocess.run(
+        ["git", "ls-files", "-z"], cwd=ROOT, capture_output=True, text=True, check=False
+    )
+    if result.returncode != 0:
+        pytest.skip("not a git checkout")
+    names = {path.split("/")[0] for path in result.stdout.split("\0") if "/" in path}
+    return sorted(name for name in names if not name.startswith("."))
+
+
+def _commands() -> list[str]:
+    """The CLI's subcommands, from argparse's refusal of an unknown one (whatever builds it)."""
+    result = subprocess.run(
+        [sys.executable, "-m", "rpr3gen.cli", "no-such-command"], capture_output=True, text=True
+    )
+    found = re.search(r"invalid choice: .*?\(choose from (.+?)\)", result.stderr)
+    assert found, result.stderr
+    return [name.strip().strip("'\"") for name in found.group(1).split(",")]
+
+
+def test_the_architecture_page_names_every_package_and_folder() -> None:
+    text = ARCHITECTURE.read_text(encoding="utf-8")
+    folders = [f"{name}/" for name in _top_folders()]
+    assert {"derive/", "generated/", "src/", "tests/"} <= set(folders)
+    missing = [f for f in folders if f"`{f}" not in text]
+    missing += [
+        f"{path}/ ({dotted})"
+        for path, dotted in _packages()
+        if not any(f"`{path}{end}" in text for end in "/`") and dotted not in text
+    ]
+    assert "`src/rpr3gen/`" in text
+    assert not missing, f"docs/architecture.md does not mention: {', '.join(missing)}"
+
+
+def test_the_architecture_page_names_every_command() -> None:
+    commands = _commands()
+    assert {"simulate", "generate"} <= set(commands)
+    text = ARCHITECTURE.read_text(encoding="utf-8")
+    missing = [c for c in commands if not re.search(rf"`(rpr3gen )?{re.escape(c)}`", text)]
+    assert not missing, f"docs/architecture.md does not mention the commands: {missing}"
+
+
+def test_the_mkdocs_nav_holds_the_architecture_page() -> None:
+    assert "architecture.md" in (ROOT / "mkdocs.yml").read_text(encoding="utf-8")
