@@ -311,10 +311,14 @@ def _top_folders() -> list[str]:
 
 
 def _commands() -> list[str]:
-    """The CLI's subcommands, from argparse's refusal of an unknown one (whatever builds it)."""
-    result = subprocess.run(
-        [sys.executable, "-m", "rpr3gen.cli", "no-such-command"], capture_output=True, text=True
+    """The CLI's subcommands, from argparse's refusal of an unknown one, asked of the ``rpr3gen``
+    console script's entry point (whatever module builds the parser)."""
+    code = (
+        "import sys; from importlib.metadata import entry_points\n"
+        "(script,) = entry_points(group='console_scripts', name='rpr3gen')\n"
+        "sys.argv = ['rpr3gen', 'no-such-command']; sys.exit(script.load()())\n"
     )
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     found = re.search(r"invalid choice: .*?\(choose from (.+?)\)", result.stderr)
     assert found, result.stderr
     return [name.strip().strip("'\"") for name in found.group(1).split(",")]
