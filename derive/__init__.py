@@ -7,6 +7,9 @@ Two halves, one way only:
 
 - ``codegen/``: a generic engine (programs, specs, CSE, one backend per language with its
   printer and templates, rendering, regeneration check) that imports nothing of the robot;
-- ``planar/``: any planar 3-leg robot (legs → kinematics → dynamics → virtual work), its
+- ``planar/``: the robot, any planar 3-leg one (leg types and structures → geometry →
+  kinematics → dynamics → virtual work, the control model, identification), its
   ``registry/`` of function specs, and ``generate``, which runs the engine on them.
+
+docs/architecture.md draws the layers.
 """

@@ -81,7 +81,7 @@ pytestmark = pytest.mark.usefixtures("variant_cache")  # general variants: deriv
 # -- scenes: a robot, a motion it follows, every other input from the runtime --------------
 
 ROOT = Path(__file__).resolve().parent.parent
-PAPER_TOML = Path(rpr3gen.model.__file__).parent / "models" / "paper.toml"
+PAPER_TOML = Path(rpr3gen.__file__).parent / "models" / "paper.toml"
 N_FIT = 40  # identify: enough equations, well conditioned (condition number about 40)
 T6 = np.linspace(0.0, 0.5, 6)
 Q6 = np.column_stack([0.01 * T6, -0.01 * T6, 0.1 * T6])

@@ -432,7 +432,7 @@ def test_directory_and_binary_file(tmp_path: Path) -> None:
 
 
 def test_runtime_modules_do_not_need_sympy() -> None:
-    src = str(Path(rpr3gen.model.__file__).resolve().parents[1])
+    src = str(Path(rpr3gen.__file__).resolve().parents[1])
     code = (
         "import sys; sys.modules['sympy'] = None\n"
         "import rpr3gen.model, rpr3gen.trajectory, rpr3gen.atomic, rpr3gen.plots\n"

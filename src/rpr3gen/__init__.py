@@ -14,8 +14,6 @@ regeneration lives in the package ``rpr3gen_derive`` (folder ``derive/``) and wr
 ``rpr3gen_generated`` (folder ``generated/``).
 """
 
-import importlib.metadata
-
 from rpr3gen.backends import BACKENDS, OUTPUT_NAMES, evaluate, inverse_dynamics
 from rpr3gen.control import (
     actuator_coordinates,
@@ -55,11 +53,7 @@ from rpr3gen.identification import (
 from rpr3gen.model import PARAM_NAMES, Model, load_model, model_from_dict
 from rpr3gen.sample import SampleEvaluator
 from rpr3gen.trajectory import Trajectory, paper_trajectory, read_trajectory_csv
-
-try:
-    __version__ = importlib.metadata.version("rpr3gen")
-except importlib.metadata.PackageNotFoundError:  # the source tree on sys.path, not installed
-    __version__ = "0+unknown"
+from rpr3gen.version import __version__
 
 __all__ = [
     "BACKENDS",

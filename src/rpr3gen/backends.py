@@ -3,7 +3,7 @@ name (:func:`evaluate`).
 
 This module shapes arrays, picks the model's generated variant (:mod:`rpr3gen.manifest`), runs
 it in blocks through an evaluator (:mod:`rpr3gen.evaluators`) and applies the failure policy
-(:mod:`rpr3gen.policy`), so every backend gives the same NaN rows and return codes.
+(:mod:`rpr3gen.failures`), so every backend gives the same NaN rows and return codes.
 """
 
 from __future__ import annotations
@@ -16,7 +16,7 @@ from collections.abc import Iterator, Sequence
 import numpy as np
 from numpy.typing import ArrayLike
 
-from rpr3gen import manifest, policy, sizes, variants
+from rpr3gen import failures, manifest, sizes, variants
 from rpr3gen.errors import InputError, InputTypeError
 from rpr3gen.evaluators import BACKENDS, NumpyEvaluator, evaluator, thread_count
 from rpr3gen.model import Model
@@ -152,7 +152,7 @@ def evaluate(
         ins, outs = [a[block] for a in arrays], [o[block] for o in outputs]
         failed = ev.run(info, params, ins, outs, count)
         if failed != 0:  # unknown (NumPy), or the C counted some: find them while in cache
-            codes[block] = policy.apply(info, ins, outs, applied=ev.applies_checks)
+            codes[block] = failures.apply(info, ins, outs, applied=ev.applies_checks)
     public = [o for o, arg in zip(outputs, info.outputs, strict=True) if not arg.hidden]
     return public, codes
 

@@ -72,7 +72,7 @@ class Evaluator(Protocol):
     """Evaluates the functions of one generated variant.
 
     ``applies_checks``: the backend applies the failure conditions itself (the generated C
-    does, writing NaN rows; see :func:`rpr3gen.policy.return_codes`).
+    does, writing NaN rows; see :func:`rpr3gen.failures.return_codes`).
     """
 
     variant: Variant
@@ -93,7 +93,7 @@ class Evaluator(Protocol):
     ) -> int | None:
         """Evaluate n samples: ``inputs`` (n, size) C-contiguous float64, ``outputs`` rows of
         arrays from :meth:`allocate`, on up to ``threads`` threads. Failed samples hold inf or
-        NaN (see :mod:`rpr3gen.policy`). Returns how many failed, when the backend knows."""
+        NaN (see :mod:`rpr3gen.failures`). Returns how many failed, when the backend knows."""
         ...
 
 

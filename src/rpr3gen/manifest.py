@@ -2,7 +2,7 @@
 
 ``rpr3gen generate`` writes one ``manifest.json`` per variant beside the generated NumPy and C
 sources. The runtime reads nothing else about the generated functions: it calls them by name,
-builds the C binding and applies the failure policy (:mod:`rpr3gen.policy`) from it.
+builds the C binding and applies the failure policy (:mod:`rpr3gen.failures`) from it.
 
 A generated folder is either the installed package ``rpr3gen_generated`` (the default) or any
 folder written by ``rpr3gen generate --out DIR`` (``load_model(..., generated=DIR)``).

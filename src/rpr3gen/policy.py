@@ -4,119 +4,31 @@ command refuses.
 Two levels:
 
 1. **What the generated functions refuse** (a return code other than 0): the failure conditions
-   of each function, with their thresholds and codes, come from the manifest
-   (:mod:`rpr3gen.manifest`; e.g. ``conditioning`` under ``MIN_CONDITIONING`` = 1e-9 is
-   ``SINGULAR``). The generated C applies them itself; :func:`return_codes` applies the same
-   conditions to any backend's results, so the NumPy and C paths agree on every code, and
-   :func:`apply` blanks the failed samples (NaN).
-2. **What ``rpr3gen simulate`` refuses** on top: poses closer to a singularity than
-   ``--min-conditioning`` (:data:`DEFAULT_MIN_CONDITIONING`) and piston displacements outside a
-   model's stroke limits (:func:`invalid_samples`).
+   of each function come from the manifest and are applied to any backend's results by
+   :mod:`rpr3gen.failures` (below the backends, which use it).
+2. **What ``rpr3gen simulate`` refuses** on top, here: poses closer to a singularity than
+   ``--min-conditioning`` (:data:`DEFAULT_MIN_CONDITIONING`) and joint coordinates outside a
+   model's limits (:func:`invalid_samples`).
 
 The measure of closeness to a parallel singularity is the generated output ``conditioning``
-(``derive/rpr3/virtual_work.py``: the Hadamard ratio of the closure matrix whose solve gives every
-load, with the platform's rotation scaled by its radius): 1 at best, 0 at a singular pose, where
-the loads grow as 1/conditioning.
+(``derive/planar/virtual_work.py``: the Hadamard ratio of the closure matrix whose solve gives
+every load, with the platform's rotation scaled by its radius): 1 at best, 0 at a singular pose,
+where the loads grow as 1/conditioning.
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
 
-from rpr3gen.manifest import FunctionInfo
+from rpr3gen.backends import evaluate
 from rpr3gen.model import LEGS, Model
 
 #: Default refusal threshold of ``rpr3gen simulate`` on ``conditioning``: loads there are
 #: ~1000x their well-conditioned size. On the paper's robot and motions it stays above 0.6.
 DEFAULT_MIN_CONDITIONING = 1e-3
-
-
-def finite_rows(array: np.ndarray) -> np.ndarray:
-    """(n,) bool: every value of the row is finite, for an (n, k) array of either layout.
-
-    One pass over the values in memory order answers the usual case, all finite; only then is
-    each row looked at (``isfinite(...).all(axis=1)`` over rows of 3 would cost ten times more).
-    """
-    if np.isfinite(array).all():
-        return np.ones(array.shape[0], dtype=bool)
-    return np.isfinite(array.T).all(axis=0)
-
-
-def return_codes(
-    function: FunctionInfo,
-    inputs: Sequence[np.ndarray],
-    outputs: Sequence[np.ndarray],
-    applied: bool = False,
-) -> np.ndarray:
-    """Per sample, the code the generated C returns for it: 0, or the first failed check's.
-
-    Args:
-        function: the function, from the manifest.
-        inputs: its inputs, each (n, size).
-        outputs: all its outputs as computed, hidden ones included, each (n, size).
-        applied: the backend applied the checks itself and wrote a failed sample as a row of
-            NaN (the generated C batch): then a failed sample's code is the input check's when
-            an input is not finite, else the one code all the other checks share.
-
-    Returns:
-        (n,) int array.
-    """
-    n = inputs[0].shape[0]
-    codes = np.zeros(n, dtype=np.intc)
-    pending = np.ones(n, dtype=bool)
-    if applied:
-        public = [o for o, info in zip(outputs, function.outputs, strict=True) if not info.hidden]
-        failed = np.zeros(n, dtype=bool)
-        for out in public:
-            failed |= np.isnan(out).all(axis=1)
-        for check in function.checks:
-            if check.kind == "inputs_not_finite":
-                bad = ~np.all([finite_rows(a) for a in inputs], axis=0)
-                codes[bad] = check.code
-                pending &= ~bad
-        later = [c.code for c in function.checks if c.kind != "inputs_not_finite"]
-        if later:
-            codes[failed & pending] = later[0]
-        return codes
-    with np.errstate(invalid="ignore"):
-        for check in function.checks:
-            if check.kind == "inputs_not_finite":
-                failed = ~np.all([finite_rows(a) for a in inputs], axis=0)
-            elif check.kind == "custom":  # C only, applied there
-                continue
-            elif check.kind == "below":
-                assert check.output is not None
-                assert check.component is not None
-                value = outputs[check.output][:, check.component]
-                failed = ~(value >= check.threshold)
-            else:
-                public = [o for o, i in zip(outputs, function.outputs, strict=True) if not i.hidden]
-                failed = ~np.all([finite_rows(a) for a in public], axis=0)
-            hit = failed & pending
-            codes[hit] = check.code
-            pending &= ~hit
-    return codes
-
-
-def apply(
-    function: FunctionInfo,
-    inputs: Sequence[np.ndarray],
-    outputs: Sequence[np.ndarray],
-    applied: bool = False,
-) -> np.ndarray:
-    """Blank (NaN) every output row of a failed sample, in place; return the codes.
-
-    ``applied``: as in :func:`return_codes`.
-    """
-    codes = return_codes(function, inputs, outputs, applied)
-    failed = codes != 0
-    if failed.any():
-        for out in outputs:
-            out[failed] = np.nan
-    return codes
 
 
 @dataclass(frozen=True)
@@ -175,8 +87,6 @@ def _singular_reason(
                 "folds onto the serial singularity |A1A3| = 0"
             )
     else:
-        from rpr3gen.backends import evaluate
-
         (diagnostics,), _ = evaluate(model, "pose_diagnostics", (q,))
         *reaches, conditioning = diagnostics[0]
         for leg, r in zip(LEGS, reaches, strict=True):

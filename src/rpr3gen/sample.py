@@ -20,7 +20,7 @@ from collections.abc import Mapping
 import numpy as np
 from numpy.typing import ArrayLike
 
-from rpr3gen import policy, variants
+from rpr3gen import failures, variants
 from rpr3gen.errors import InputError, Rpr3genError
 from rpr3gen.evaluators import evaluator
 from rpr3gen.model import Model
@@ -95,7 +95,7 @@ class SampleEvaluator:
             return int(self._call(*self._args))
         inputs = [v[np.newaxis, :] for v in self.inputs.values()]
         self._evaluator.run(self.function, self.params, inputs, self._scratch)
-        code = int(policy.return_codes(self.function, inputs, self._scratch)[0])
+        code = int(failures.return_codes(self.function, inputs, self._scratch)[0])
         if code == 0:
             for out, scratch in zip(self.outputs.values(), self._scratch, strict=False):
                 out[:] = scratch[0]  # the public outputs come first

@@ -46,7 +46,6 @@ __all__ = [
     "Flag",
     "Instance",
     "Integer",
-    "IsModel",
     "Number",
     "Optional",
     "PathArg",
@@ -224,15 +223,6 @@ class Instance(Check):
         return value
 
 
-class IsModel(Instance):
-    """A :class:`rpr3gen.Model` (from :func:`rpr3gen.load_model`), not a file name."""
-
-    def __init__(self) -> None:
-        from rpr3gen.model import Model  # the model module checks its own values with this one
-
-        super().__init__(Model, "a Model (rpr3gen.load_model(...))")
-
-
 class Optional(Check):
     """None, or what ``check`` accepts."""
 
@@ -379,8 +369,9 @@ COMMON: dict[str, Check] = {
     "friction": Flag(),
     "min_conditioning": Number(least=0.0, below=1.0),
 }
-"""Checks of the arguments that mean the same in every function (``model`` is added on first
-use, to import :mod:`rpr3gen.model` late)."""
+"""Checks of the arguments that mean the same in every function. The model package, above this
+module, adds ``model`` (:class:`rpr3gen.model.IsModel`) when it is imported: every module with a
+function that takes a ``model`` imports it first."""
 
 
 def checked(
@@ -409,12 +400,11 @@ def checked(
         parameters = list(signature.parameters.values())
         skip = 1 if parameters and parameters[0].name in ("self", "cls") else 0
         names = [p.name for p in parameters[skip:]]
-        if "model" in names and "model" not in checks and "model" not in COMMON:
-            COMMON["model"] = IsModel()
         found = {name: checks.get(name) or COMMON.get(name) for name in names}
         missing = [name for name, check in found.items() if check is None]
         if missing:
-            raise TypeError(f"{function.__qualname__}: no check for {', '.join(missing)}")
+            hint = " (import rpr3gen.model first)" if "model" in missing else ""
+            raise TypeError(f"{function.__qualname__}: no check for {', '.join(missing)}{hint}")
         table: dict[str, Check] = {n: c for n, c in found.items() if c is not None}
         positional = [
             p.name

@@ -43,8 +43,8 @@ import numpy as np
 
 from rpr3gen import sizes
 from rpr3gen.errors import GridError, ModelError, did_you_mean
-from rpr3gen.general_model import LEG_KEYS, is_general
 from rpr3gen.model import ACTUATIONS, DEFAULT_GRAVITY, MODEL_KEYS, Model, model_from_dict
+from rpr3gen.model.general import LEG_KEYS, is_general
 from rpr3gen.structure import LEGS
 
 __all__ = ["Grid", "read_grid"]

@@ -40,8 +40,8 @@ from rpr3gen.design.reach import (
 )
 from rpr3gen.design.stacked import evaluate_stacked, param_rows
 from rpr3gen.errors import ModelError
-from rpr3gen.general_model import is_general
 from rpr3gen.model import LEGS, Model
+from rpr3gen.model.general import is_general
 from rpr3gen.policy import invalid_samples
 from rpr3gen.trajectory import Trajectory
 

@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from rpr3gen import policy, variants
+from rpr3gen import failures, variants
 from rpr3gen.backends import BLOCK
 from rpr3gen.evaluators import evaluator
 from rpr3gen.model import LEGS, PARAM_NAMES, Model
@@ -42,7 +42,7 @@ class Evaluated:
         values: ``{component name: (n,) array}`` for every output component, the hidden ones
             (``reach``, ``conditioning`` of the ``guards``) included. Values are as computed:
             a refused sample (code not 0) may hold anything, so read them with ``codes``.
-        codes: (n,) the return code of each sample (0: ok; :mod:`rpr3gen.policy`).
+        codes: (n,) the return code of each sample (0: ok; :mod:`rpr3gen.failures`).
         groups: ``{output array name: its component names}`` (e.g. ``"tau"``).
     """
 
@@ -81,7 +81,7 @@ def evaluate_stacked(
 
     Returns:
         Every output component by name, raw, and the return codes that the failure policy
-        gives each sample (:func:`rpr3gen.policy.return_codes`).
+        gives each sample (:func:`rpr3gen.failures.return_codes`).
     """
     variant = variants.load(model.structure, model.generated)
     info = variant.function(function)
@@ -101,7 +101,7 @@ def evaluate_stacked(
             ev.run(info, p, ins, outs)
         except ValueError:
             _by_runs(ev, info, p, ins, outs)
-    codes = policy.return_codes(info, arrays, outputs, applied=False)
+    codes = failures.return_codes(info, arrays, outputs, applied=False)
     values = {
         name: out[:, k]
         for arg, out in zip(info.outputs, outputs, strict=True)

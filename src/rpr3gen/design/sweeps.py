@@ -51,6 +51,7 @@ from rpr3gen.trajectory import (
     paper_trajectory,
 )
 from rpr3gen.validation import checked
+from rpr3gen.version import __version__
 
 __all__ = [
     "DEFAULT_AREA_RESOLUTION",
@@ -264,8 +265,6 @@ def identity(plan: SweepPlan) -> str:
     """A hash of everything that decides a sweep's results (SHA-256, hex): the base model, the
     grid, the trajectories, the options, the chunking, the runtime's version and the generated
     code's."""
-    from rpr3gen import __version__
-
     digest = hashlib.sha256()
     for traj in plan.trajectories:
         for array in (traj.t, traj.q, traj.qd, traj.qdd):

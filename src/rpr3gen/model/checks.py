@@ -1,11 +1,11 @@
 """The checks of a :class:`rpr3gen.Model` built directly (``Model(name, actuation, params, ...)``
 or ``dataclasses.replace``): each field's type and value, and its generated folder.
 
-A model read from a file is checked key by key first (:mod:`rpr3gen.model`); these checks make
-a model built in code just as safe: a wrong type is an :class:`~rpr3gen.errors.InputTypeError`,
-a bad value a :class:`~rpr3gen.errors.ModelError` naming the field, and a generated folder that
-is damaged or of another version a plain :class:`~rpr3gen.errors.Rpr3genError`
-(:mod:`rpr3gen.loader`).
+A model read from a file is checked key by key first (:mod:`rpr3gen.model.paper`,
+:mod:`rpr3gen.model.general`); these checks make a model built in code just as safe: a wrong
+type is an :class:`~rpr3gen.errors.InputTypeError`, a bad value a
+:class:`~rpr3gen.errors.ModelError` naming the field, and a generated folder that is damaged or
+of another version a plain :class:`~rpr3gen.errors.Rpr3genError` (:mod:`rpr3gen.loader`).
 """
 
 from __future__ import annotations
@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 
 from rpr3gen.errors import InputTypeError, ModelError, did_you_mean
+from rpr3gen.loader import check_folder
 from rpr3gen.structure import LEGS, Structure
 from rpr3gen.validation import PathArg, describe
 
@@ -61,8 +62,6 @@ def check_fields(model: Any, actuations: Sequence[str]) -> dict:
     limits = None if model.limits is None else _limits(model.limits, source, structure)
     generated = None
     if model.generated is not None:
-        from rpr3gen.loader import check_folder
-
         generated = PathArg()("generated", model.generated)
         check_folder(structure.variant, generated, tuple(param_names))
     return {

@@ -1,7 +1,7 @@
 """The general model file: any planar 3-leg robot, everything given at home (docs/interfaces.md).
 
 A file with a top-level ``leg`` key is read here; one without it is the paper's format
-(:mod:`rpr3gen.model`). Home is the platform pose ``(0, 0, 0)`` (the platform frame on the
+(:mod:`rpr3gen.model.paper`). Home is the platform pose ``(0, 0, 0)`` (the platform frame on the
 world frame) with every joint coordinate 0::
 
     name = "my-3rrr"
@@ -39,7 +39,8 @@ from typing import Any
 import numpy as np
 
 from rpr3gen.errors import ModelError, did_you_mean
-from rpr3gen.model import DEFAULT_GRAVITY, Model, _describe, _Reader
+from rpr3gen.model.reading import Reader, describe
+from rpr3gen.model.types import DEFAULT_GRAVITY, Model
 from rpr3gen.structure import LEG_TYPES, LEGS, Structure
 
 #: Allowed keys per table (None: a value; a dict: a sub-table).
@@ -108,21 +109,24 @@ def home_conditioning(structure: Structure, legs: Mapping[str, Mapping[str, np.n
     return abs(float(np.linalg.det(W))) / math.sqrt(rho2) / math.prod(norms)
 
 
-class GeneralReader(_Reader):
+class GeneralReader(Reader):
     """Validates a general model file; every failure names the file and the dotted key."""
 
+    schema = SCHEMA
+
     def read(self, data: Any) -> Model:
+        """The model of the parsed TOML ``data``."""
         if not isinstance(data, Mapping):
-            raise ModelError(f"{self.source}: a model must be a table, got {_describe(data)}")
+            raise ModelError(f"{self.source}: a model must be a table, got {describe(data)}")
         self.check_keys({k: v for k, v in data.items() if k != "limits"}, SCHEMA, "")
         name = self.required(data, "name", "name")
         if not isinstance(name, str) or not name.strip():
-            self.fail("name", f"must be a non-empty string, got {_describe(name)}")
+            self.fail("name", f"must be a non-empty string, got {describe(name)}")
         structure = self.structure(data)
         legs_table = self.table(data, "legs", required=True)
         symmetric = data.get("symmetric", False)
         if not isinstance(symmetric, bool):
-            self.fail("symmetric", f"must be true or false, got {_describe(symmetric)}")
+            self.fail("symmetric", f"must be true or false, got {describe(symmetric)}")
         legs = self.legs(legs_table, structure, symmetric)
         platform = self.platform(self.table(data, "platform", required=True))
         params: dict[str, float] = {}
@@ -156,12 +160,12 @@ class GeneralReader(_Reader):
             self.fail(
                 "leg",
                 f"must be one of {', '.join(LEG_TYPES)} (joint types from base to platform; "
-                f"PPP cannot turn the platform), got {_describe(leg)}{hint}",
+                f"PPP cannot turn the platform), got {describe(leg)}{hint}",
             )
         actuated = self.required(data, "actuated", "actuated")
         if isinstance(actuated, bool) or actuated not in (1, 2, 3):
             self.fail(
-                "actuated", f"must be 1, 2 or 3 (the motor's joint), got {_describe(actuated)}"
+                "actuated", f"must be 1, 2 or 3 (the motor's joint), got {describe(actuated)}"
             )
         structure = Structure(leg, int(actuated))
         if structure.singular:
@@ -313,7 +317,7 @@ class GeneralReader(_Reader):
         if not table:
             return None
         if not isinstance(table, Mapping):
-            self.fail("limits", f"must be a table [limits], got {_describe(table)}")
+            self.fail("limits", f"must be a table [limits], got {describe(table)}")
         names = [f"{leg}.q{j}" for leg in LEGS for j in (1, 2, 3)] + [f"q{j}" for j in (1, 2, 3)]
         out: dict[str, tuple[float, float]] = {}
         for key in table:
