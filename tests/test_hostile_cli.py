@@ -224,8 +224,8 @@ COMMANDS: tuple[Command, ...] = (
 
 
 def test_every_command_has_a_row() -> None:
-    from rpr3gen.cli import _parser
-    from rpr3gen.cli_args import subparser
+    from rpr3gen.cli import build_parser as _parser
+    from rpr3gen.commands.args import subparser
 
     parser = _parser()
     commands = next(a for a in parser._actions if a.dest == "command").choices

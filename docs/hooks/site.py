@@ -261,7 +261,7 @@ def _commands_page() -> str:
     """One section per command of ``rpr3gen``, its ``--help`` as argparse prints it."""
     from rpr3gen import cli
 
-    parser = cli._parser()
+    parser = cli.build_parser()
     parts = [
         "# Commands\n",
         "Every command of `rpr3gen`, with its options, defaults and units. This page is "

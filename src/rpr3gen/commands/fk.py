@@ -1,0 +1,52 @@
+"""``rpr3gen fk``: forward kinematics, every assembly mode of three actuator readings with its
+conditioning."""
+
+from __future__ import annotations
+
+import argparse
+
+import numpy as np
+
+from rpr3gen.backends import inverse_dynamics
+from rpr3gen.commands import options
+from rpr3gen.commands.args import number
+from rpr3gen.model import load_model
+
+NAME = "fk"
+
+
+def add_parser(sub: argparse._SubParsersAction) -> None:
+    """The ``fk`` subcommand's parser."""
+    parser = sub.add_parser(
+        NAME,
+        help="forward kinematics: every assembly mode of three actuator readings",
+        description="Print every assembly mode of the actuator coordinates QA1 QA2 QA3 (legs A, "
+        "B, C: phi10 in rad with revolute actuation, lambda21 in m with prismatic), one per "
+        "line: x y (m) phi (rad, in (-pi, pi]) and the pose's conditioning (0 = singular, 1 = "
+        "best).",
+    )
+    options.add_model(parser)
+    options.add_generated(parser)
+    parser.add_argument("qa", nargs=3, type=number(), metavar="QA", help="actuator coordinate")
+
+
+def run(args: argparse.Namespace) -> int:
+    """Print a header line, then ``x y phi conditioning`` of each assembly mode."""
+    from rpr3gen.control import assembly_modes
+
+    model = load_model(args.model, generated=args.generated)
+    qa = np.array(args.qa)  # three finite numbers (args.number)
+    modes = assembly_modes(model, qa)
+    zero = np.zeros_like(modes)
+    conditioning = (
+        inverse_dynamics(model, modes, zero, zero)["conditioning"] if len(modes) else zero
+    )
+    family = model.structure.actuator
+    what = f"{model.actuation} actuation" if model.structure.paper else model.structure.title
+    print(
+        f"# {len(modes)} assembly mode(s) of {family} = {' '.join(f'{v:g}' for v in qa)} "
+        f"({model.name}, {what}): x y phi conditioning"
+    )
+    for mode, c in zip(modes, conditioning, strict=True):
+        print(f"{mode[0]:.12g} {mode[1]:.12g} {mode[2]:.12g} {c:.6g}")
+    return 0

@@ -1,0 +1,128 @@
+"""``rpr3gen generate``: derive and write the generated sources, the committed variants into
+the source tree's ``generated/`` or one structure's variant; ``--check`` only compares."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from rpr3gen import variants
+from rpr3gen.errors import InputError, Rpr3genError, did_you_mean
+from rpr3gen.model import load_model
+from rpr3gen.paths import check_output
+from rpr3gen.structure import LEG_TYPES, Structure
+
+NAME = "generate"
+
+
+def add_parser(sub: argparse._SubParsersAction) -> None:
+    """The ``generate`` subcommand's parser."""
+    parser = sub.add_parser(
+        NAME,
+        help="derive and write the generated sources",
+        description="Derive and write generated code. Without --leg or --model: the committed "
+        "variants (the paper's revolute and prismatic, and rrr_1) into the source tree's "
+        "generated/. With --leg and --actuated (or --model): that one structure's variant, into "
+        "--out DIR, or by default into the cache where the runtime finds it (see "
+        "RPR3GEN_CACHE_DIR).",
+    )
+    parser.add_argument(
+        "--model",
+        metavar="FILE",
+        help="generate only this model's variant (default: the committed variants)",
+    )
+    parser.add_argument(
+        "--leg",
+        metavar="TYPE",
+        help="generate the variant of this leg type (RRR RPR RRP PRR PPR PRP RPP); needs the "
+        "actuated joint too (default: the committed variants)",
+    )
+    parser.add_argument(
+        "--actuated",
+        type=int,
+        metavar="J",
+        help="the joint (1, 2 or 3) of every leg that carries its motor; needs the leg type "
+        "too (default: none)",
+    )
+    parser.add_argument(
+        "--out",
+        metavar="DIR",
+        help="output folder (default: the source tree's generated/, or the cache for one "
+        "structure)",
+    )
+    parser.add_argument(
+        "--check",
+        action="store_true",
+        help="write nothing; fail if the sources are stale (default: write them)",
+    )
+
+
+def run(args: argparse.Namespace) -> int:
+    """Render the sources (needs the ``derive`` extra) and write them, or check them."""
+    if args.out and not args.check:  # before sympy loads: a second, not an hour of work
+        check_output(args.out, "the generated sources", folder=True, argument="out")
+    try:
+        from rpr3gen_derive.codegen import files as codegen_files
+        from rpr3gen_derive.planar import generate, structures
+    except ImportError as exc:
+        raise Rpr3genError(
+            f"regeneration needs sympy and jinja2 ({exc.name} is missing): "
+            "pip install 'rpr3gen[derive]'"
+        ) from exc
+    one = _structure(args)
+    if one is not None:
+        if one.singular:
+            raise Rpr3genError(
+                f"--actuated: a {one.title} cannot move: both its passive joints are prismatic "
+                "(architecturally singular); nothing to generate"
+            )
+        target = structures.Structure(one.leg, one.actuated, one.paper)
+        committed = target in generate.COMMITTED
+        if args.out:
+            out_dir = Path(args.out)
+        elif committed and generate.default_out_dir() is not None:
+            out_dir = generate.default_out_dir()
+        else:
+            out_dir = variants.folder(one)
+        package = generate.COMMITTED if committed and not args.out else (target,)
+        files = generate.render((target,), package=package)
+    else:
+        out_dir = Path(args.out) if args.out else generate.default_out_dir()
+        if out_dir is None:
+            raise Rpr3genError("no source tree's generated/ folder here; name one with --out DIR")
+        if not args.check:
+            check_output(out_dir, "the generated sources", folder=True, argument="out")
+        files = generate.render(generate.COMMITTED)
+    if args.check:
+        stale = codegen_files.stale_files(out_dir, files)
+        if stale:
+            raise Rpr3genError(
+                f"{out_dir}: stale or edited generated files: {', '.join(stale)}; "
+                "run `rpr3gen generate`"
+            )
+        print(f"{out_dir}: {len(files)} generated files up to date")
+        return 0
+    changed = codegen_files.write_files(out_dir, files)
+    print(f"{out_dir}: {len(changed)} of {len(files)} files changed")
+    return 0
+
+
+def _structure(args: argparse.Namespace) -> Structure | None:
+    """The one structure ``rpr3gen generate`` was asked for, or None for the committed ones."""
+    if args.leg is not None or args.actuated is not None:
+        if args.model:
+            raise InputError("--model: not together with --leg and --actuated")
+        if args.leg is None or args.actuated is None:
+            raise InputError("--leg and --actuated go together")
+        leg = str(args.leg).upper()
+        if leg not in LEG_TYPES:
+            hint = did_you_mean(leg, LEG_TYPES)
+            raise InputError(
+                f"--leg: must be one of {', '.join(LEG_TYPES)}, got {args.leg!r}{hint}"
+            )
+        if args.actuated not in (1, 2, 3):
+            raise InputError(f"--actuated: must be 1, 2 or 3, got {args.actuated}")
+        return Structure(leg, args.actuated)
+    if args.model:
+        return load_model(args.model).structure
+    return None
