@@ -138,3 +138,21 @@ def test_wheel_runs_simulate_in_a_fresh_venv(repo_root: Path, tmp_path: Path) ->
     ).stdout  # fmt: skip
     assert str(repo_root) not in where
     assert all(path.startswith(str(site)) for path in where.split()), where
+
+
+def test_every_package_folder_is_in_the_wheel(repo_root: Path) -> None:
+    """Each folder with an ``__init__.py`` under the three package roots is listed in
+    ``pyproject.toml``'s ``packages`` (a new subpackage left out installs editable, yet its
+    wheel would lack it)."""
+    import tomllib
+
+    setup = tomllib.loads((repo_root / "pyproject.toml").read_text())["tool"]["setuptools"]
+    listed = set(setup["packages"])
+    found = set()
+    for name, folder in setup["package-dir"].items():
+        for init in (repo_root / folder).rglob("__init__.py"):
+            parts = init.parent.relative_to(repo_root / folder).parts
+            if "__pycache__" not in parts:
+                found.add(".".join((name, *parts)))
+    assert found - listed == set(), "not in pyproject.toml's packages"
+    assert listed - found == set(), "listed but not a package"
