@@ -1,8 +1,8 @@
-"""Tables from a benchmark run: ``python benchmarks/report.py results.json [--readme]``.
+"""Tables from a benchmark run: ``python benchmarks/report.py results.json [--docs]``.
 
 Reads what ``run.py`` wrote and writes the Markdown beside it (``results.json`` ->
-``results.md``); with ``--readme`` also README.md's Performance block, between its
-``<!-- performance`` markers. Every figure comes from the one file; nothing is measured here.
+``results.md``); with ``--docs`` also the Performance block of ``docs/performance.md``, between
+its ``<!-- performance`` markers. Every figure comes from the one file; nothing is measured here.
 """
 
 from __future__ import annotations
@@ -15,7 +15,9 @@ from pathlib import Path
 from typing import Any
 
 REPO = Path(__file__).resolve().parent.parent
-BEGIN = "<!-- performance: written by `python benchmarks/run.py --readme`; do not edit -->"
+#: The page whose Performance block ``--docs`` writes.
+PAGE = REPO / "docs" / "performance.md"
+BEGIN = "<!-- performance: written by `python benchmarks/run.py --docs`; do not edit -->"
 END = "<!-- end of performance -->"
 #: The tick's generated calls in the Python example (control_loop.py's Controller).
 TICK_CALLS = ("forward_kinematics", "platform_velocity", "actuator_efforts")
@@ -298,7 +300,7 @@ def document(r: dict[str, Any]) -> str:
     return "".join(parts)
 
 
-def readme_block(r: dict[str, Any]) -> str:
+def docs_block(r: dict[str, Any]) -> str:
     every = ["**Every structure**:\n", structures(r)] if r.get("structures") else []
     return "\n".join([BEGIN, header(r), targets(r), functions(r, "revolute"), control_loop(r),
                       *every, END])  # fmt: skip
@@ -307,16 +309,18 @@ def readme_block(r: dict[str, Any]) -> str:
 def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=(__doc__ or "").split("\n", 1)[0])
     parser.add_argument("results", help="the JSON file run.py wrote")
-    parser.add_argument("--readme", action="store_true", help="also README.md's tables")
+    parser.add_argument(
+        "--docs", "--readme", dest="docs", action="store_true",
+        help="also the tables of docs/performance.md (--readme: the former name)",
+    )  # fmt: skip
     args = parser.parse_args(argv)
     path = Path(args.results)
     r = json.loads(path.read_text())
     path.with_suffix(".md").write_text(document(r))
-    if args.readme:
-        readme = REPO / "README.md"
-        text = readme.read_text()
+    if args.docs:
+        text = PAGE.read_text()
         pattern = re.compile(re.escape(BEGIN) + ".*?" + re.escape(END), re.S)
-        readme.write_text(pattern.sub(lambda _: readme_block(r), text, count=1))
+        PAGE.write_text(pattern.sub(lambda _: docs_block(r), text, count=1))
     return 0
 
 

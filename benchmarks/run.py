@@ -1,4 +1,4 @@
-"""Every benchmark of rpr3gen in one command: ``python benchmarks/run.py [--quick] [--readme]``.
+"""Every benchmark of rpr3gen in one command: ``python benchmarks/run.py [--quick] [--docs]``.
 
 Runs, over the paper's variants in ``generated/`` (``harness/samples.py``): the C per-function
 harness (``harness/cbench.py``: floor, single call, batch), the control-loop examples
@@ -9,7 +9,7 @@ cached, fresh interpreters), the same C per-function harness and NumPy per funct
 Variants that ``generated/`` lacks are derived into the run's own cache folder (a temporary
 ``RPR3GEN_CACHE_DIR``), never the user's. Writes ``benchmarks/results.json`` (every figure, the
 machine and its load average at the start and the end), then ``report.py`` turns it into
-``benchmarks/results.md`` and, with ``--readme``, README.md's Performance tables.
+``benchmarks/results.md`` and, with ``--docs``, the Performance tables of ``docs/performance.md``.
 
 ``--quick`` (fewer repeats) and ``--structures rrr_1,prr_1`` (those structures alone, without
 the paper's figures: about a minute a structure with ``--quick``) write ``results-quick.json``
@@ -173,7 +173,10 @@ def measure(results: dict[str, Any], structures: Sequence[str], quick: bool) -> 
 def main() -> int:
     parser = argparse.ArgumentParser(description=(__doc__ or "").split("\n", 1)[0])
     parser.add_argument("--quick", action="store_true", help="fewer repeats; results-quick.*")
-    parser.add_argument("--readme", action="store_true", help="also README.md's tables")
+    parser.add_argument(
+        "--docs", "--readme", dest="docs", action="store_true",
+        help="also the tables of docs/performance.md (--readme: the former name)",
+    )  # fmt: skip
     parser.add_argument(
         "--structures", type=chosen, default="all", metavar="LIST",
         help="the structures measured: all (the default: a full run) or variant names, "
@@ -181,8 +184,8 @@ def main() -> int:
     )  # fmt: skip
     args = parser.parse_args()
     partial = args.structures != samples.structures()
-    if args.readme and partial:
-        parser.error("--readme needs a run of every structure")
+    if args.docs and partial:
+        parser.error("--docs needs a run of every structure")
     start = time.monotonic()
     results: dict[str, Any] = {"machine": machine(), "quick": args.quick,
                                "load_start": os.getloadavg()}  # fmt: skip
@@ -194,7 +197,7 @@ def main() -> int:
     out = results_path(args.quick or partial)
     out.write_text(dump(results) + "\n")
     log(f"wrote {out.relative_to(REPO)}")
-    report.main([str(out), *(["--readme"] if args.readme else [])])
+    report.main([str(out), *(["--docs"] if args.docs else [])])
     return 0
 
 

@@ -169,8 +169,9 @@ class _Cluster:
                 stderr=subprocess.DEVNULL,
             )
         ]
-        # As README's "On a cluster" says: workers that keep their freed memory (Dask's nanny
-        # would make them return it beyond 64 KiB, and every NumPy temporary page-faults).
+        # As docs/design-studies.md's "On a cluster" says: workers that keep their freed memory
+        # (Dask's nanny would make them return it beyond 64 KiB, and every NumPy temporary
+        # page-faults).
         env = {**os.environ, "MALLOC_TRIM_THRESHOLD_": str(1 << 28),
                "MALLOC_MMAP_THRESHOLD_": str(1 << 25)}  # fmt: skip
         for k in range(2):

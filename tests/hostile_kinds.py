@@ -24,7 +24,7 @@ import numpy as np
 from rpr3gen.errors import InputError
 
 HUGE = 10**12
-"""A size beyond any memory limit (10^12 of anything is refused: README, "sizes")."""
+"""A size beyond any memory limit (10^12 of anything is refused: docs/errors.md, "Sizes")."""
 
 
 @dataclass(frozen=True)

@@ -374,7 +374,7 @@ def test_threads_must_be_positive() -> None:
     for bad in (0, -1):
         with pytest.raises(rpr3gen.InputError):
             rpr3gen.inverse_dynamics(model, q, q, q, backend="c", threads=bad)
-    for bad in (1.5, True):  # not integers: the wrong type (README, "Errors from Python")
+    for bad in (1.5, True):  # not integers: the wrong type (docs/errors.md, "Errors from Python")
         with pytest.raises(rpr3gen.InputTypeError):
             rpr3gen.inverse_dynamics(model, q, q, q, backend="c", threads=bad)
     from rpr3gen.cli import main

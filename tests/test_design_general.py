@@ -4,7 +4,7 @@ The maps of :func:`rpr3gen.workspace` for the gallery's 3-RRR (``models/rrr.toml
 3-RRR with joint limits and a 3-PRR without limits (the prismatic default of the design
 studies), checked against ``planar_reference`` (inverse kinematics, serial determinants and the
 Newton-Euler statics, written apart from the derivation) and against a brute-force rule written
-here from the README's "Design studies": reachable where every leg reaches the pose in its
+here from docs/design-studies.md: reachable where every leg reaches the pose in its
 working mode with ``reach = min D_i / D_i(home)`` at least 1e-9, the closure's conditioning at
 least the threshold and every bounded joint coordinate within its limits. The conditioning is
 rebuilt here from its definition (docs/conventions.md): the Hadamard ratio of the rows that
@@ -85,7 +85,8 @@ def _robot(data: dict[str, Any]) -> pr.Robot:
 
 def _limits(data: dict[str, Any], robot: pr.Robot) -> list[tuple[int, int, float, float]]:
     """``(leg index, joint, lo, hi)``: the file's limits, and every other prismatic coordinate
-    within plus or minus its leg's length at home |P2 - P1| + |P3 - P2| (README)."""
+    within plus or minus its leg's length at home |P2 - P1| + |P3 - P2|
+    (docs/design-studies.md)."""
     given = data.get("limits", {})
     out = []
     for i, name in enumerate(pr.LEGS):

@@ -60,6 +60,13 @@ def test_the_site_builds_strictly(tmp_path: Path) -> None:
     assert (site / "animation" / "paper-rotation.gif").is_file()
     start = (site / "getting-started" / "index.html").read_text(encoding="utf-8")
     assert "pip install" in re.sub(r"<[^>]+>", "", start)  # the README's Quick start, included
+    errors = (site / "errors" / "index.html").read_text(encoding="utf-8")
+    assert "RPR3GEN_MAX_MEMORY" in errors  # the README's former sections, now pages of their own
+    assert "<!-- end of performance -->" in (site / "performance" / "index.html").read_text(
+        encoding="utf-8"
+    )
+    notebooks = (site / "notebooks" / "index.html").read_text(encoding="utf-8")
+    assert 'href="derivation/"' in notebooks  # ../notebooks/derivation.ipynb: the notebook's page
     api = (site / "api" / "index.html").read_text(encoding="utf-8")
     assert 'id="rpr3gen.inverse_dynamics"' in api
     assert 'id="rpr3gen.animation.write_animation"' in api
@@ -86,6 +93,22 @@ def test_links_out_of_the_docs_and_includes() -> None:
     assert "[the model](conventions.md#frames)" in out
     assert "code (`src/rpr3gen/cli.py`)" in out
     assert "[w](https://x.org)" in out
+    page = ROOT / "docs" / "notebooks.md"  # files the site shows as pages: links to the pages
+    out = hooks._rewrite_links("[nb](../notebooks/simulation.ipynb)", page, "notebooks.md")
+    assert out == "[nb](notebooks/simulation.ipynb)"
+    out = hooks._rewrite_links("[r](../benchmarks/results.md#x)", page, "performance.md")
+    assert out == "[r](benchmarks/results.md#x)"
+    out = hooks._rewrite_links("[b](../benchmarks/README.md)", page, "performance.md")
+    assert out == "b (`benchmarks/README.md`)"
     section = hooks._section("# A\n\n## B\nb text\n```\n# not a heading\n```\n## C\nc\n", "B")
     assert section == "b text\n```\n# not a heading\n```\n"
     assert hooks._section("# A\n", "Z") is None
+
+
+def test_each_fact_lives_in_one_page() -> None:
+    """The pages hold their text: of the README, only the Quick start is included (the one
+    section the front page and the site both show)."""
+    for page in sorted((ROOT / "docs").glob("*.md")):
+        for m in _hooks().INCLUDE.finditer(page.read_text(encoding="utf-8")):
+            if m[2] == "README.md":
+                assert m[3].strip() == "Quick start", f"{page.name} includes README.md#{m[3]}"

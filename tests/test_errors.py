@@ -1,5 +1,5 @@
 """The package's errors are also the standard exceptions: ValueError for bad values, TypeError
-for wrong types, so code that catches those catches them too (errors.py, README "Errors")."""
+for wrong types, so code that catches those catches them too (errors.py, docs/errors.md)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Hostile input to every public Python function: the README's classes, the argument named,
+"""Hostile input to every public Python function: docs/errors.md's classes, the argument named,
 never a crash, never a silent wrong answer (issue 23).
 
 One row of :func:`apis` per function of ``rpr3gen.__all__`` (and the public methods); the cases
@@ -497,7 +497,7 @@ GENERATED = Kind(
     lambda v: None if isinstance(v, str | Path) else "type",
     wrong_types=(5, b"gen", ["gen"]),
     bad_values=(Where("missing", lambda tmp: str(tmp / "nothing")), ""),
-    value_error=Rpr3genError,  # the environment: a plain Rpr3genError (README)
+    value_error=Rpr3genError,  # the environment: a plain Rpr3genError (docs/errors.md)
 )
 NAME = Kind(
     "trajectory name",

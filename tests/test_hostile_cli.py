@@ -1,5 +1,5 @@
 """Hostile input to every command: one line on stderr naming what is at fault, exit status 2,
-no traceback, nothing written and nothing lost (issue 23; README, "Bad input ...").
+no traceback, nothing written and nothing lost (issue 23; docs/errors.md).
 
 One row of :data:`COMMANDS` per command: its valid invocation, its numeric options (each with
 the values it takes), its outputs and its input files. The cases are drawn from the rows:

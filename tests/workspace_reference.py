@@ -2,7 +2,7 @@
 
 Written from ``docs/conventions.md`` and ``docs/interfaces.md`` with NumPy alone (nothing from
 ``rpr3gen``): the legs' lengths straight from the geometry, the closure matrix of the
-conditioning, and the reachability rule of the design studies (README, "Design studies").
+conditioning, and the reachability rule of the design studies (docs/design-studies.md).
 
 Leg i: base pivot ``A1_i`` (world), platform joint ``p_i`` (platform frame),
 ``A3_i = G + R(phi) p_i``, ``|A1A3| = l0 + l2 + lambda21_i``. Conditioning: the Hadamard ratio

@@ -5,17 +5,21 @@ source:
 
 - ``<!-- include FILE#HEADING -->`` in a page is replaced by that section of FILE (a path from
   the repository's root; the section runs to the next heading of its level or above): the
-  README's Quick start, its model file ...; ``include-intro`` stops at the section's first
-  subheading.
+  README's Quick start, the one section the README (the front page) and the site both show;
+  ``include-intro`` stops at the section's first subheading.
 - ``commands.md`` is generated from the command line's own ``--help`` (argparse), one section
   per command.
 - ``<!-- file PATH -->`` becomes the whole file as a code block (a gallery model ...).
 - ``<!-- header-excerpt VARIANT -->`` becomes the defines and the inverse dynamics' prototypes
   of ``generated/VARIANT/rpr3.h``.
 - The notebooks (``notebooks/*.ipynb``) and the benchmark reports (``benchmarks/*.md`` but its
-  README) become pages, whatever files exist; their navigation entries are added here.
-- A link to a file of the repository outside ``docs/`` cannot work on the site: it becomes the
-  file's path as code. Links within ``docs/`` are MkDocs' to check (``--strict``).
+  README) become pages, whatever files exist; their navigation entries are added here, after
+  the page that introduces them when the navigation has it (``notebooks.md``,
+  ``performance.md``: that entry becomes a section), else as sections of their own.
+- A link to a file of the repository outside ``docs/`` (``../notebooks/simulation.ipynb``, as
+  GitHub reads it) goes to its page when the site shows it (a notebook, a benchmark report);
+  any other cannot work on the site: it becomes the file's path as code. Links within ``docs/``
+  are MkDocs' to check (``--strict``).
 - Every public function and class of ``rpr3gen`` (its ``__all__``) and of the modules the API
   page documents must have a docstring: one missing is a warning, so a strict build fails.
 """
@@ -58,6 +62,17 @@ def _benchmark_reports() -> list[Path]:
     return sorted(p for p in (ROOT / "benchmarks").glob("*.md") if p.name != "README.md")
 
 
+def _site_pages() -> dict[Path, str]:
+    """The files outside ``docs/`` that the site shows as pages: path -> the page's source URI."""
+    pages = {p: f"notebooks/{p.name}" for p in _notebooks()}
+    pages.update({p: f"benchmarks/{p.name}" for p in _benchmark_reports()})
+    return pages
+
+
+#: The pages that introduce the generated sections: section title -> page.
+SECTION_PAGES = {"Notebooks": "notebooks.md", "Benchmarks": "performance.md"}
+
+
 def _title(path: Path) -> str:
     """A page's title: its first heading, or its name."""
     if path.suffix == ".md":
@@ -83,7 +98,15 @@ def on_config(config: Any) -> Any:
     notebooks = [{_title(p): f"notebooks/{p.name}"} for p in _notebooks()]
     reports = [{_title(p): f"benchmarks/{p.name}"} for p in _benchmark_reports()]
     for title, entries in (("Notebooks", notebooks), ("Benchmarks", reports)):
-        if entries:
+        if not entries:
+            continue
+        page = SECTION_PAGES[title]
+        for k, item in enumerate(nav):
+            if isinstance(item, dict) and list(item.values()) == [page]:
+                (name,) = item
+                nav[k] = {name: [{"Overview": page}, *entries]}
+                break
+        else:
             nav.append({title: entries})
     return config
 
@@ -218,8 +241,9 @@ def _rewrite_links(
 ) -> str:
     """Links of ``source`` (a file of the repository) as they must read on page ``page_uri``.
 
-    A target inside ``docs/`` is made relative to the page; any other file of the repository
-    becomes its path as code (the site has no copy of it). An anchor of an included file goes
+    A target inside ``docs/``, or a notebook or benchmark report (the site shows them as pages),
+    is made relative to the page; any other file of the repository becomes its path as code (the
+    site has no copy of it). An anchor of an included file goes
     where ``anchors`` says its heading is shown, or the link becomes its label when it is
     shown nowhere. External links stay.
     """
@@ -238,6 +262,10 @@ def _rewrite_links(
             return f"[{label}]({where or '#'})" if where else m[0]
         path, _, anchor = target.partition("#")
         resolved = (source.parent / path).resolve()
+        shown_as = _site_pages().get(resolved)
+        if shown_as is not None and not bang:
+            new = posixpath.relpath(shown_as, page_dir or ".") + (f"#{anchor}" if anchor else "")
+            return f"[{label}]({new})"
         if resolved.is_relative_to(DOCS):
             inside = resolved.relative_to(DOCS).as_posix()
             new = posixpath.relpath(inside, page_dir or ".") + (f"#{anchor}" if anchor else "")

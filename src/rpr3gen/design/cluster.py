@@ -35,7 +35,8 @@ Columns = dict[str, Any]
 #: Dask's setting that makes its worker processes return freed memory to the system beyond 64 KiB
 #: (``MALLOC_TRIM_THRESHOLD_``). With it, glibc maps and unmaps every large NumPy temporary of
 #: the generated code, and the page faults halve a sweep's speed; the local cluster's workers
-#: run without it (glibc's default: freed memory is reused). See README, "On a cluster".
+#: run without it (glibc's default: freed memory is reused). See docs/design-studies.md, "On a
+#: cluster".
 MALLOC_TRIM = "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_"
 
 
