@@ -64,8 +64,9 @@ from rpr3gen.errors import (
     Rpr3genError,
     TrajectoryError,
 )
-from rpr3gen.identification import MAX_WEIGHT_RATIO, Fit, inertial_parameters
+from rpr3gen.identification import MAX_WEIGHT_RATIO, Fit
 from rpr3gen.model import ACTUATIONS, Model
+from rpr3gen.parameters import inertial_parameters
 from rpr3gen.structure import Structure
 
 SETTINGS = settings(

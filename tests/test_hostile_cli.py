@@ -27,7 +27,7 @@ import rpr3gen
 from rpr3gen import manifest
 from rpr3gen.cli import main
 from rpr3gen.excitation import FourierMotion
-from rpr3gen.identification import inertial_parameters
+from rpr3gen.parameters import inertial_parameters
 
 # -- the options' values ------------------------------------------------------------------
 

@@ -22,6 +22,7 @@ import pytest
 
 import rpr3gen
 from rpr3gen import identification as idn
+from rpr3gen import parameters
 from rpr3gen.cli import main
 from rpr3gen.excitation import Excitation, FourierMotion
 from rpr3gen.model import Model
@@ -213,7 +214,7 @@ def test_the_literature_ten_parameters_have_rank_nine() -> None:
     rank 9 in our regressor: the piston's mass regroups."""
     model, q, qd, qdd, _ = _exciting("revolute", 1)
     W = rpr3gen.regressor(model, q, qd, qdd, identical_legs=True).reshape(-1, 12)
-    names = idn.SHARED_PARAMETER_NAMES
+    names = parameters.SHARED_PARAMETER_NAMES
     ten = ["Jzz_1", "mcx_1", "mcy_1", "mcx_2", "mcy_2", "m_2", "Jzz_3", "mcx_3", "mcy_3", "m_3"]
     cols = W[:, [names.index(n) for n in ten]]
     s = np.linalg.svd(cols / np.linalg.norm(cols, axis=0), compute_uv=False)

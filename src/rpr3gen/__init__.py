@@ -41,16 +41,16 @@ from rpr3gen.errors import (
     TrajectoryWarning,
 )
 from rpr3gen.excitation import excite
-from rpr3gen.identification import (
+from rpr3gen.identification import identify
+from rpr3gen.model import PARAM_NAMES, Model, load_model, model_from_dict
+from rpr3gen.parameters import (
     INERTIAL_PARAMETER_NAMES,
     base_parameters,
     base_regressor,
-    identify,
     inertial_parameters,
     payload_efforts,
     regressor,
 )
-from rpr3gen.model import PARAM_NAMES, Model, load_model, model_from_dict
 from rpr3gen.sample import SampleEvaluator
 from rpr3gen.trajectory import Trajectory, paper_trajectory, read_trajectory_csv
 from rpr3gen.version import __version__

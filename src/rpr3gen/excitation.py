@@ -1,7 +1,7 @@
 """Exciting trajectories for identification: a finite Fourier series optimised for the regressor.
 
 A motion identifies the base parameters well when the stacked base regressor ``W`` (every
-sample's ``Yb``, :func:`rpr3gen.identification.base_regressor`) is well conditioned (Swevers,
+sample's ``Yb``, :func:`rpr3gen.parameters.base_regressor`) is well conditioned (Swevers,
 Ganseman, Tukel, De Schutter and Van Brussel 1997; Gautier and Khalil 1992). The paper's two
 motions are not: along either, W loses a rank (docs/identification.md). :func:`excite`
 optimises, per platform coordinate k (x, y, phi), the periodic motion
@@ -28,13 +28,9 @@ from rpr3gen import sizes, variants
 from rpr3gen.backends import evaluate
 from rpr3gen.control import platform_radius
 from rpr3gen.errors import IdentificationError, InputError
-from rpr3gen.identification import (
-    base_parameters,
-    friction_columns_of_rates,
-    one_blas_thread,
-    shared_matrix,
-)
+from rpr3gen.identification import friction_columns_of_rates
 from rpr3gen.model import LEGS, Model
+from rpr3gen.parameters import base_parameters, one_blas_thread, shared_matrix
 from rpr3gen.policy import joint_limits
 from rpr3gen.trajectory import Trajectory
 from rpr3gen.validation import Integer, Number, Reading, checked

@@ -117,7 +117,7 @@ def fit_toml(fit: Fit, model: Model, data: str) -> str:
 def _model_base(fit: Fit) -> np.ndarray:
     """The model file's base parameters, round-off (e.g. J1 + J2 - l2^2 m2 of the paper's
     robot, exactly 0) shown as 0."""
-    from rpr3gen.identification import inertial_parameters
+    from rpr3gen.parameters import inertial_parameters
 
     values = fit.base.matrix @ inertial_parameters(fit.model, fit.identical_legs)
     values[np.abs(values) < 1e-12 * np.abs(values).max()] = 0.0
