@@ -122,14 +122,7 @@ def evaluate(
         The outputs of the function's interface, each seen as (n, size), and the (n,) return
         codes (0: ok). The outputs of a failed sample are NaN, whatever the backend.
     """
-    variant = variants.load(model.structure, model.generated)
-    if function not in variant.functions:
-        known = ", ".join(variant.functions)
-        raise InputError(
-            f"function: no generated function {function!r} (there are: {known})",
-            argument="function",
-        )
-    info = variant.function(function)
+    variant, info = variants.load_function(model.structure, model.generated, function)
     if len(inputs) != len(info.inputs):
         names = ", ".join(arg.name for arg in info.inputs)
         raise InputError(

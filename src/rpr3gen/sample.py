@@ -55,14 +55,7 @@ class SampleEvaluator:
     ):
         self.model = model
         self.backend = backend
-        variant = variants.load(model.structure, model.generated)
-        if function not in variant.functions:
-            known = ", ".join(variant.functions)
-            raise InputError(
-                f"function: no generated function {function!r} (there are: {known})",
-                argument="function",
-            )
-        self.function = variant.function(function)
+        variant, self.function = variants.load_function(model.structure, model.generated, function)
         self.codes = dict(variant.code_meanings)
         self.params = np.ascontiguousarray(model.vector(variant.param_names))
         given = dict(buffers or {})

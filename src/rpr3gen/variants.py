@@ -26,7 +26,7 @@ from functools import cache
 from pathlib import Path
 
 from rpr3gen import manifest
-from rpr3gen.errors import Rpr3genError
+from rpr3gen.errors import InputError, Rpr3genError
 from rpr3gen.structure import Structure
 
 __all__ = ["cache_root", "ensure", "folder", "generator_hash", "load"]
@@ -127,3 +127,21 @@ def load(structure: Structure, generated: str | os.PathLike[str] | None = None) 
     if structure.variant in manifest.available():
         return manifest.load(structure.variant)
     return manifest.load(structure.variant, ensure(structure))
+
+
+def load_function(
+    structure: Structure, generated: str | os.PathLike[str] | None, function: str
+) -> tuple[manifest.Variant, manifest.FunctionInfo]:
+    """The variant (:func:`load`) and its generated function ``function``.
+
+    Raises:
+        InputError: no such function, naming the argument and the variant's functions.
+    """
+    variant = load(structure, generated)
+    if function not in variant.functions:
+        known = ", ".join(variant.functions)
+        raise InputError(
+            f"function: no generated function {function!r} (there are: {known})",
+            argument="function",
+        )
+    return variant, variant.function(function)

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass
+from typing import TypeVar
 
 import numpy as np
 
@@ -33,14 +34,13 @@ DEFAULT_GRAVITY: tuple[float, float] = (0.0, -9.81)
 """Gravity in the world frame (y0 up) when the model file has no ``environment.gravity``, m/s²."""
 
 
-class _ReadOnlyParams(Mapping[str, float]):
-    """An immutable, hashable, picklable ``str -> float`` mapping that keeps its key order."""
+_V = TypeVar("_V")
 
-    def __init__(self, items: Mapping[str, float]) -> None:
-        self._data = dict(items)
 
-    def __getitem__(self, key: str) -> float:
-        return self._data[key]
+class _ReadOnly(Mapping[str, _V]):
+    """An immutable, hashable mapping over ``self._data`` (a dict its subclass builds)."""
+
+    _data: dict[str, _V]
 
     def __iter__(self) -> Iterator[str]:
         return iter(self._data)
@@ -56,6 +56,16 @@ class _ReadOnlyParams(Mapping[str, float]):
 
     def __repr__(self) -> str:
         return f"{type(self).__name__}({self._data!r})"
+
+
+class _ReadOnlyParams(_ReadOnly[float]):
+    """An immutable, hashable, picklable ``str -> float`` mapping that keeps its key order."""
+
+    def __init__(self, items: Mapping[str, float]) -> None:
+        self._data = dict(items)
+
+    def __getitem__(self, key: str) -> float:
+        return self._data[key]
 
 
 @dataclass(frozen=True)
@@ -124,7 +134,7 @@ class Model:
         return np.array([self.params[n] for n in names], dtype=np.float64)
 
 
-class _ReadOnlyLimits(Mapping[str, tuple[float, float]]):
+class _ReadOnlyLimits(_ReadOnly[tuple[float, float]]):
     """An immutable, hashable ``"A.q2" -> (lo, hi)`` mapping in sorted key order."""
 
     def __init__(self, items: Mapping[str, tuple[float, float]]) -> None:
@@ -132,21 +142,6 @@ class _ReadOnlyLimits(Mapping[str, tuple[float, float]]):
 
     def __getitem__(self, key: str) -> tuple[float, float]:
         return self._data[key]
-
-    def __iter__(self) -> Iterator[str]:
-        return iter(self._data)
-
-    def __len__(self) -> int:
-        return len(self._data)
-
-    def __hash__(self) -> int:
-        return hash(tuple(self._data.items()))
-
-    def __eq__(self, other: object) -> bool:
-        return isinstance(other, Mapping) and dict(self.items()) == dict(other.items())
-
-    def __repr__(self) -> str:
-        return f"{type(self).__name__}({self._data!r})"
 
 
 class IsModel(Instance):
