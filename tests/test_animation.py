@@ -73,7 +73,7 @@ def test_refuses_absurd_requests_up_front(request_: dict, words: str) -> None:
 
 
 def test_mp4_needs_ffmpeg(monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.setattr(animation, "_ffmpeg_available", lambda: False)
+    monkeypatch.setattr(animation.frames, "_ffmpeg_available", lambda: False)
     with pytest.raises(InputError, match="ffmpeg"):
         animation.plan(np.linspace(0.0, 1.0, 3), "robot.mp4")
 
@@ -182,7 +182,7 @@ def test_cli_writes_the_movie(tmp_path: Path, capsys: pytest.CaptureFixture[str]
         assert (gif.n_frames, gif.size) == (4, (320, 240))
 
 
-@pytest.mark.skipif(not animation._ffmpeg_available(), reason="ffmpeg is not installed")
+@pytest.mark.skipif(not animation.frames._ffmpeg_available(), reason="ffmpeg is not installed")
 def test_mp4_through_ffmpeg(tmp_path: Path) -> None:
     model, traj = _robot("rrr")
     out = tmp_path / "rrr.mp4"
