@@ -98,8 +98,10 @@ class Trajectory:
                 )
             value.setflags(write=False)
             object.__setattr__(self, name, value)
-        if not np.isfinite(t).all() or (np.diff(t) <= 0).any():
-            k = int(np.flatnonzero(~np.isfinite(t) | np.r_[False, np.diff(t) <= 0])[0])
+        with np.errstate(invalid="ignore"):  # inf - inf: that t is refused as not finite
+            bad = ~np.isfinite(t) | np.r_[False, ~(np.diff(t) > 0)]
+        if bad.any():
+            k = int(np.flatnonzero(bad)[0])
             raise TrajectoryError(
                 f"trajectory: t must be finite and strictly increasing, got t[{k}] = {t[k]:g}"
                 + (f" after {t[k - 1]:g}" if k else "")
