@@ -49,16 +49,6 @@ def repo_root() -> Path:
     return ROOT
 
 
-@pytest.fixture(scope="session")
-def variant_cache() -> Path:
-    """The cache of generated variants and compiled C that the session's tests share: the
-    session's folder (``$RPR3GEN_CACHE_DIR``, set in :func:`pytest_configure`). Every worker
-    derives a variant once: its entries are keyed by content hashes of the generator and of the
-    C, so nothing stale is ever reused, and the variants' lock makes concurrent first uses
-    safe."""
-    return Path(os.environ["RPR3GEN_CACHE_DIR"])
-
-
 @pytest.fixture
 def quick_c_builds(monkeypatch: pytest.MonkeyPatch) -> None:
     """The c backend builds at -O0 in this test (half a second instead of seven): for tests of

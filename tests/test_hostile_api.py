@@ -81,7 +81,6 @@ SETTINGS = settings(
     suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much],
 )
 
-pytestmark = pytest.mark.usefixtures("variant_cache")  # general variants: derived once
 
 # -- scenes: a robot, a motion it follows, every other input from the runtime --------------
 

@@ -38,7 +38,6 @@ except ImportError:
     import planar_reference as pr
 
 mujoco = pytest.importorskip("mujoco")
-pytestmark = pytest.mark.usefixtures("variant_cache")
 
 ROOT = Path(__file__).resolve().parent.parent
 LEGS = pr.LEGS

@@ -51,7 +51,6 @@ except ImportError:
     import planar_models as pm
     import planar_reference as pr
 
-pytestmark = pytest.mark.usefixtures("variant_cache")
 
 ROOT = Path(__file__).resolve().parent.parent
 LEGS = chk.LEGS

@@ -142,7 +142,6 @@ CASES = {"gallery": _gallery, **{f"random{k}": functools.partial(
     lambda k: _congruent_robot(np.random.default_rng(500 + k)), k) for k in range(3)}}  # fmt: skip
 
 
-@pytest.mark.usefixtures("variant_cache")
 @pytest.mark.parametrize("name", list(CASES))
 def test_schappl_p3rrr1_gives_rpr3gen_s_jacobian_dynamics_and_torques(name: str) -> None:
     data = CASES[name]()
