@@ -26,8 +26,9 @@ def build_parser() -> argparse.ArgumentParser:
     """The parser of ``rpr3gen``, with every command of :data:`rpr3gen.commands.COMMANDS`."""
     parser = Parser(
         prog="rpr3gen",
-        description="Inverse dynamics of the 3-RPR planar parallel robot (Staicu), "
-        "from generated code. SI units throughout (m, rad, s, N, N·m).",
+        description="Inverse dynamics with every joint load, control model, identification "
+        "and design studies of planar 3-leg parallel robots (Staicu's method; the paper's "
+        "3-RPR by default), from generated code. SI units throughout (m, rad, s, N, N·m).",
         epilog="Run 'rpr3gen COMMAND --help' for the options of a command.",
     )
     parser.add_argument("--version", action="version", version=f"rpr3gen {__version__}")
