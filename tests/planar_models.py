@@ -15,8 +15,10 @@ import numpy as np
 
 try:
     from . import planar_reference as pr
+    from .newton_euler import sinusoid_motion  # a motion, not physics: shared by both references
 except ImportError:
     import planar_reference as pr
+    from newton_euler import sinusoid_motion
 
 LEGS = pr.LEGS
 
@@ -198,26 +200,6 @@ def random_model(
     raise RuntimeError(f"no valid random ({leg}, {actuated}) model after {attempts} draws")
 
 
-def sinusoids(
-    rng: np.random.Generator, t: np.ndarray, amp: tuple[float, float, float], terms: int = 3
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """q, qd, qdd (n, 3): per coordinate an offset plus ``terms`` sinusoids, exact derivatives."""
-    t = np.asarray(t, dtype=float)
-    q = np.zeros((t.size, 3))
-    qd = np.zeros_like(q)
-    qdd = np.zeros_like(q)
-    for j in range(3):
-        q[:, j] += amp[j] * rng.uniform(-0.5, 0.5)
-        for _ in range(terms):
-            a = amp[j] * rng.uniform(-1, 1) / terms
-            w = rng.uniform(0.5, 6.0)
-            ph = rng.uniform(0, 2 * math.pi)
-            q[:, j] += a * np.sin(w * t + ph)
-            qd[:, j] += a * w * np.cos(w * t + ph)
-            qdd[:, j] -= a * w**2 * np.sin(w * t + ph)
-    return q, qd, qdd
-
-
 def motion_ok(robot: pr.RobotLike, q: np.ndarray) -> bool:
     """True when every sample is reachable in the working mode with normalised ``|D|`` at least
     :data:`SERIAL_MIN_MOTION` and the scaled actuator Jacobian's condition number at most
@@ -249,7 +231,7 @@ def random_motion(
     for k in range(attempts):
         if k and k % 10 == 0:
             scale *= 0.8
-        q, qd, qdd = sinusoids(rng, t, tuple(scale * a for a in amp))
+        q, qd, qdd = sinusoid_motion(rng, t, tuple(scale * a for a in amp))
         if motion_ok(robot, q):
             return q, qd, qdd
     raise RuntimeError(f"no valid motion for {robot.name} after {attempts} draws")

@@ -489,7 +489,7 @@ def test_symmetric_robot_turns_with_the_scene() -> None:
         }
     )
     rng = np.random.default_rng(5)
-    q, qd, qdd = pm.sinusoids(rng, np.linspace(0, 1, 9), (0.02, 0.02, 0.1))
+    q, qd, qdd = ne.sinusoid_motion(rng, np.linspace(0, 1, 9), (0.02, 0.02, 0.1))
     out = pr.solve(robot, q, qd, qdd)
     qt, qdt, qddt = (np.concatenate([a[:, :2] @ R.T, a[:, 2:]], axis=1) for a in (q, qd, qdd))
     out_t = pr.solve(turned, qt, qdt, qddt)
