@@ -137,6 +137,17 @@ int main(int argc, char **argv)
         trig(&s, &c, &fast_mismatch, nextafter(x, 0.0));
         trig(&s, &c, &fast_mismatch, nextafter(x, INFINITY));
     }
+    /* the full kernel's branch at |x| = pi/4 (no reduction below): 64 doubles on either
+     * side, both signs, must give the fast path's bits */
+    for (i = 0; i < 2; ++i) {
+        double below = i ? -0.7853981633974483 : 0.7853981633974483, above = below;
+        for (k = 0; k < 64; ++k) {
+            trig(&s, &c, &fast_mismatch, below);
+            trig(&s, &c, &fast_mismatch, above);
+            below = nextafter(below, 0.0);
+            above = nextafter(above, i ? -INFINITY : INFINITY);
+        }
+    }
     for (e = -1074; e <= 1023; ++e) {
         for (k = 0; k < 100 * scale; ++k) {
             trig(&s, &c, &fast_mismatch, in_binade(e));

@@ -15,7 +15,8 @@ central configuration; leg ``i`` has base pivot ``A1_i`` (world), platform joint
 ``rho`` the platform's RMS joint radius.
 
 The tracked forward kinematics (:func:`tracked_forward_kinematics`) is damped Newton on the
-closure ``qa(q) = qa_measured`` from a reference pose, with the actuator Jacobian ``J = d qa/dq``;
+closure ``qa(q) = qa_measured`` from a reference pose, with the actuator Jacobian ``J = d qa/dq``
+and each step corrected to third order (Chebyshev) by the closure's second derivative along it;
 when it does not converge, or lands in another aspect (``det J`` changed sign), it falls back to
 every assembly mode and picks the one nearest the reference.
 """
@@ -137,6 +138,30 @@ def actuator_jacobian(geom: Geometry, actuation: str, q: Sequence[float]) -> lis
     return rows
 
 
+def actuator_curvature(
+    geom: Geometry, actuation: str, q: Sequence[float], dq: Sequence[float]
+) -> list[float]:
+    """``H[dq, dq]``: the second derivative of ``qa(q + s dq)`` in ``s`` at 0, per leg.
+
+    Along ``dq`` the leg vector ``d`` moves at ``v = (dx, dy) + dphi (-s_y, s_x)`` with
+    acceleration ``a = -dphi^2 s``; then ``theta'' = (d x a) / L^2 - 2 (d . v)(d x v) / L^4``
+    (revolute) or ``L'' = (v . v + d . a) / L - (d . v)^2 / L^3`` (prismatic).
+    """
+    d, r = _legs(geom, q)
+    out = []
+    for (dx, dy), (sx, sy) in zip(d, r, strict=True):
+        vx, vy = dq[0] - dq[2] * sy, dq[1] + dq[2] * sx
+        ax, ay = -(dq[2] ** 2) * sx, -(dq[2] ** 2) * sy
+        l2 = dx * dx + dy * dy
+        dv = dx * vx + dy * vy
+        if actuation == "revolute":
+            out.append((dx * ay - dy * ax) / l2 - 2.0 * dv * (dx * vy - dy * vx) / l2**2)
+        else:
+            length = math.sqrt(l2)
+            out.append((vx * vx + vy * vy + dx * ax + dy * ay) / length - dv**2 / length**3)
+    return out
+
+
 def det3(m: Sequence[Sequence[float]]) -> float:
     return (
         m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
@@ -180,9 +205,11 @@ def closure_newton(
 ) -> NewtonResult:
     """Damped Newton on ``qa(q) = qa``, from ``q0``.
 
-    Each step solves ``J dq = -(qa(q) - qa)`` (3 x 3, cofactors), limits ``|dq|`` in the pose
-    metric to ``max_step`` (default: the platform's RMS radius ``rho``) and halves it until the
-    largest residual drops by the Armijo factor ``1 - t/2`` (at most ``max_halvings`` times).
+    Each step solves ``J dq = -(qa(q) - qa)`` (3 x 3, cofactors), adds the Chebyshev correction
+    ``e``, ``J e = -H[dq, dq] / 2`` (:func:`actuator_curvature`), when ``|e| <= |dq| / 2`` in the
+    pose metric, limits ``|dq|`` in the pose metric to ``max_step`` (default: the platform's RMS
+    radius ``rho``) and halves it until the largest residual drops by the Armijo factor
+    ``1 - t/2`` (at most ``max_halvings`` times).
     Converged when the largest residual is at most ``tol`` (rad or m). Fails (``converged``
     False) on a singular ``J`` (``|det J|`` below 1e-14 of the product of its row norms), a
     failed line search, or ``max_iter`` steps.
@@ -205,6 +232,12 @@ def closure_newton(
         bound = math.prod(math.sqrt(sum(v * v for v in row)) for row in J)
         if not abs(det) > 1e-14 * bound:
             return NewtonResult(q, False, iteration, det)
+        h = actuator_curvature(geom, actuation, q, dq)
+        e, _ = solve3(J, [-0.5 * v for v in h])
+        if math.hypot(e[0], e[1], geom.rho * e[2]) <= 0.5 * math.hypot(
+            dq[0], dq[1], geom.rho * dq[2]
+        ):
+            dq = [a + b for a, b in zip(dq, e, strict=True)]
         size = math.sqrt(dq[0] ** 2 + dq[1] ** 2 + (geom.rho * dq[2]) ** 2)
         t = min(1.0, limit / size) if size > 0 else 1.0
         for _ in range(max_halvings):
@@ -576,7 +609,8 @@ def tracked_forward_kinematics(
 
     1. :func:`closure_newton` from ``q_near`` (at most ``max_iter`` steps, largest residual
        ``<= tol``, step limited to ``rho`` in the pose metric, backtracking line search).
-    2. Accepted when it converged, every leg length is positive, and ``det J`` at the solution
+    2. Accepted when it converged, the pose is evaluable (reach above :data:`MIN_REACH`, as
+       every mode of :func:`assembly_modes`), and ``det J`` at the solution
        has the sign it has at ``q_near`` (same aspect: Newton did not jump across a parallel
        singularity into another mode).
     3. Otherwise (fallback): every mode, by the closed form (revolute) or by sampling the sextic
@@ -596,13 +630,10 @@ def tracked_forward_kinematics(
     if result.converged:
         det_near = det3(actuator_jacobian(geom, actuation, near))
         det_here = det3(actuator_jacobian(geom, actuation, result.q))
-        d, _ = _legs(geom, result.q)
-        positive = (
-            min(leg_lengths_along_axis(geom, qa, result.q))
-            if actuation == "revolute"
-            else min(math.hypot(*di) for di in d)
-        ) > LENGTH_TOL * geom.rho
-        if positive and det_near * det_here > 0:
+        # a mode is a pose the generated code evaluates, whichever path finds it (as in
+        # assembly_modes): reach above MIN_REACH, so every leg is longer than l2 > 0
+        evaluable = reach(geom, result.q) > MIN_REACH
+        if evaluable and det_near * det_here > 0:
             return Tracked(result.q, "newton", result.iterations)
     if not fallback:
         return Tracked((math.nan, math.nan, math.nan), "none", result.iterations)

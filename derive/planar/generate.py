@@ -9,7 +9,10 @@ cache on first use).
 
 from __future__ import annotations
 
+import multiprocessing
+import os
 from collections.abc import Iterable, Mapping
+from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 from rpr3gen_derive.codegen.render import Generator, Stage, no_stage
@@ -48,15 +51,47 @@ def render(
     """Every generated file for ``structures``, ``{relative path: text}``.
 
     ``package``: the variants the folder's ``__init__.py`` lists (default: ``structures``).
+    Several structures are rendered side by side, one process each (forked, so they share the
+    parent's hash seed and imports), on as many cores as there are; each variant's files depend
+    on its structure alone, so the result is the same as one after the other.
     """
-    gen = generator(stage)
     structures = tuple(structures)
+    listed = structures if package is None else tuple(package)
+    workers = min(len(structures), os.cpu_count() or 1)
+    if workers > 1 and functions is None and stage is no_stage and _can_fork():
+        files: dict[str, str] = {}
+        context = multiprocessing.get_context("fork")
+        # the costliest first (revolute joints give the longest expressions), so that the
+        # last one to start is a short one
+        order = sorted(structures, key=lambda s: -s.kinds.count("R"))
+        with ProcessPoolExecutor(workers, mp_context=context) as pool:
+            for part in pool.map(_render_one, order, [listed] * len(order)):
+                files.update(part)
+        return dict(sorted(files.items()))
+    return _render(structures, functions, stage, listed)
+
+
+def _render(
+    structures: tuple[Structure, ...],
+    functions: Mapping[str, FunctionBuilder] | None,
+    stage: Stage,
+    listed: tuple[Structure, ...],
+) -> dict[str, str]:
+    """:func:`render` in this process, one structure after the other."""
+    gen = generator(stage)
     modules = []
     for structure in structures:
         with stage(f"variant:{structure.variant}"), stage("derive"):
             modules.append(module(structure, functions))
-    listed = structures if package is None else tuple(package)
     return gen.render(modules, variants=tuple(s.variant for s in listed))
+
+
+def _render_one(structure: Structure, listed: tuple[Structure, ...]) -> dict[str, str]:
+    return _render((structure,), None, no_stage, listed)
+
+
+def _can_fork() -> bool:
+    return "fork" in multiprocessing.get_all_start_methods()
 
 
 def source_hash() -> str:

@@ -15,7 +15,7 @@ both the throughput and the dependency chain (the conditioning of every function
 
 from __future__ import annotations
 
-from functools import cache
+from functools import cache, lru_cache
 
 import sympy as sp
 from rpr3gen_derive.codegen.backends import prepare
@@ -78,8 +78,13 @@ def _printer(prefix: str, fast: bool) -> CPrinter:
     return CPrinter(prefix, fast)
 
 
+@lru_cache(maxsize=1 << 16)
 def c_code(expr: sp.Expr, prefix: str, fast: bool = False) -> str:
-    """One C99 expression; ``fast``: the batch loops' form (see the module docstring)."""
+    """One C99 expression; ``fast``: the batch loops' form (see the module docstring).
+
+    Memoised: a variant prints most statements several times (the single-sample kernel, the
+    values-only kernels, the batch's passes), and printing is a third of its generation time.
+    SymPy's equality is structural, so an equal expression prints the same text."""
     return _printer(prefix, fast).doprint(prepare(expr))
 
 

@@ -6,6 +6,8 @@ printing (:func:`rpr3gen_derive.codegen.backends.prepare`), never by editing pri
 
 from __future__ import annotations
 
+from functools import lru_cache
+
 import sympy as sp
 from rpr3gen_derive.codegen.backends import prepare
 from rpr3gen_derive.codegen.functions import INV_TWO_PI, TWO_PI
@@ -40,6 +42,8 @@ class NumpyPrinter(NumPyPrinter):
 _PRINTER = NumpyPrinter()  # stateless between calls; built once, it is most of a call's cost
 
 
+@lru_cache(maxsize=1 << 16)
 def numpy_code(expr: sp.Expr) -> str:
-    """One NumPy expression."""
+    """One NumPy expression (memoised, as :func:`~rpr3gen_derive.codegen.backends.c.printer.c_code`
+    is)."""
     return _PRINTER.doprint(prepare(expr))
