@@ -76,7 +76,10 @@ def code(variant: str) -> Variant:
 
 @cache
 def test_module(name: str) -> Any:
-    """``tests/NAME.py``, imported by path (the tests are no package)."""
+    """``tests/NAME.py``, imported by path (the tests are no package; they import each other
+    as top-level modules, as under pytest, so ``tests/`` goes on the path)."""
+    if str(REPO / "tests") not in sys.path:
+        sys.path.append(str(REPO / "tests"))
     spec = importlib.util.spec_from_file_location(
         f"rpr3bench_{name}", REPO / "tests" / f"{name}.py"
     )
