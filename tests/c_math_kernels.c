@@ -12,7 +12,7 @@
  * Prints one line per check: "NAME MAX_ULP COUNT WORST_X WORST_Y", the largest distance in
  * units in the last place between a kernel and libm over COUNT arguments, and where it is;
  * "NAME_mismatch COUNT" lines count exact-comparison failures (special values, signed zeros,
- * the fast path against the full kernel).
+ * the fast path against the full kernel, the single call's finite test against isfinite).
  */
 #include "rpr3.c"
 
@@ -116,7 +116,7 @@ int main(int argc, char **argv)
     const long scale = argc > 1 ? atol(argv[1]) : 1;
     struct worst s = {"sin", 0, 0, 0, 0}, c = {"cos", 0, 0, 0, 0}, a = {"atan2", 0, 0, 0, 0};
     struct worst r = {"rint", 0, 0, 0, 0}, mn = {"fmin", 0, 0, 0, 0}, mx = {"fmax", 0, 0, 0, 0};
-    long fast_mismatch = 0, special_mismatch = 0, k;
+    long fast_mismatch = 0, special_mismatch = 0, finite_mismatch = 0, k;
     int e, i, j;
     double x0;
 
@@ -215,6 +215,37 @@ int main(int argc, char **argv)
         }
     }
 
+    /* rpr3_finite_values, the single call's exact test of its inputs and outputs, against
+     * isfinite: each special value and 10^6 uniform bit patterns alone; rows of 53 values (the
+     * inverse dynamics' outputs) finite but for one, at every position; rows of DBL_MAX, whose
+     * sum overflows but whose values are finite. */
+    for (i = 0; i < nspecial; ++i) {
+        finite_mismatch += rpr3_finite_values(&special[i], 1) != (isfinite(special[i]) != 0);
+    }
+    for (k = 0; k < 1000000 * scale; ++k) {
+        const unsigned long long bits = next();
+        double x;
+        memcpy(&x, &bits, sizeof x);
+        finite_mismatch += rpr3_finite_values(&x, 1) != (isfinite(x) != 0);
+    }
+    {
+        double row[53];
+        for (j = 0; j < 53; ++j) {
+            row[j] = DBL_MAX;
+        }
+        finite_mismatch += rpr3_finite_values(row, 53) != 1;
+        for (i = 0; i < nspecial; ++i) {
+            for (j = 0; j < 53; ++j) {
+                int m;
+                for (m = 0; m < 53; ++m) {
+                    row[m] = any_finite();
+                }
+                row[j] = special[i];
+                finite_mismatch += rpr3_finite_values(row, 53) != (isfinite(special[i]) != 0);
+            }
+        }
+    }
+
     print(&s);
     print(&c);
     print(&a);
@@ -223,5 +254,6 @@ int main(int argc, char **argv)
     print(&mx);
     printf("fast_mismatch %ld\n", fast_mismatch);
     printf("special_mismatch %ld\n", special_mismatch);
+    printf("finite_mismatch %ld\n", finite_mismatch);
     return 0;
 }

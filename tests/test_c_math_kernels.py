@@ -71,6 +71,7 @@ def test_kernels_against_libm_over_the_whole_domain(harness: Path) -> None:
         assert float(worst) <= limit, f"{name}: {worst} ulp at x={x} (y={y})"
     assert lines["fast_mismatch"] == "0"  # the batch's fast path is the full kernel, bit for bit
     assert lines["special_mismatch"] == "0"  # NaN, infinities, signed zeros: as C99 says
+    assert lines["finite_mismatch"] == "0"  # the single call's finite test is isfinite's
 
 
 def _ulps(got: float, want: mpmath.mpf) -> float:

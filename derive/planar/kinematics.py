@@ -102,6 +102,7 @@ def platform_rotation(prog: Program) -> Platform:
 def _serial_solve(
     prog: Program,
     columns: list[Column],
+    det: sp.Expr,
     inv_det: sp.Expr,
     rhs: Column,
     names: list[str],
@@ -111,9 +112,32 @@ def _serial_solve(
     S = sp.Matrix(3, 3, lambda i, j: columns[j][i])
     adjugate = S.adjugate()
     return tuple(
-        prog.define(name, sp.expand(sum(adjugate[i, k] * rhs[k] for k in range(3))) * inv_det, step)
+        prog.define(
+            name,
+            _over(sp.expand(sum(adjugate[i, k] * rhs[k] for k in range(3))), det, inv_det),
+            step,
+        )
         for i, name in enumerate(names)
     )
+
+
+def _over(expr: sp.Expr, det: sp.Expr, inv_det: sp.Expr) -> sp.Expr:
+    """``expr / det``, ``expr`` expanded: when ``det`` is a number times one symbol (the 3-RPR's
+    ``D = -L``), the terms it divides are divided exactly (``-L dphi / -L`` is ``dphi``, and
+    ``L v / -L`` is ``-v``: no product ``L (1/L)``, which is 1 only to round-off), and only the
+    others are multiplied by ``inv_det``. Otherwise ``expr inv_det``."""
+    _, symbol = det.as_coeff_Mul()
+    if not symbol.is_Symbol:
+        return expr * inv_det
+    exact: list[sp.Expr] = []
+    rest: list[sp.Expr] = []
+    for term in sp.Add.make_args(expr):
+        _, power = term.as_independent(symbol, as_Add=False)
+        divides = power == symbol or (
+            power.is_Pow and power.base == symbol and power.exp.is_integer and power.exp.is_positive
+        )
+        (exact if divides else rest).append(term)
+    return sp.Add(*(t / det for t in exact)) + sp.Add(*rest) * inv_det
 
 
 def _point_accelerations(
@@ -175,7 +199,13 @@ def leg_kinematics(prog: Program, robot: Robot, leg: str, platform: Platform) ->
     step = STEP_VELOCITY
     v3 = frame_vector("v3", add((syms.dx, syms.dy), scale(syms.dphi, perp(s))), step)
     qd = _serial_solve(
-        prog, columns, inv_det, (v3[0], v3[1], syms.dphi), [f"{n}_{leg}" for n in names.qd], step
+        prog,
+        columns,
+        pose.D,
+        inv_det,
+        (v3[0], v3[1], syms.dphi),
+        [f"{n}_{leg}" for n in names.qd],
+        step,
     )
     omega = _rotations(g.kinds, qd)
 
@@ -188,7 +218,7 @@ def leg_kinematics(prog: Program, robot: Robot, leg: str, platform: Platform) ->
     rhs = sub(a3, bias)
     rhs = (prog.define(f"a3_{leg}_x1", rhs[0], step), prog.define(f"a3_{leg}_y1", rhs[1], step))
     qdd = _serial_solve(
-        prog, columns, inv_det, (*rhs, syms.ddphi), [f"{n}_{leg}" for n in names.qdd], step
+        prog, columns, pose.D, inv_det, (*rhs, syms.ddphi), [f"{n}_{leg}" for n in names.qdd], step
     )
     eps = _rotations(g.kinds, qdd)
     a1, a2, _ = _point_accelerations(g.kinds, pose, qd, qdd, omega, eps)

@@ -11,9 +11,15 @@ loads and stores, not by its arithmetic.
 :func:`schedule` is a greedy list scheduler over the kernel's dependency graph (parameter and
 input loads, assignments, output stores): among the statements whose operands are all computed,
 it emits the one that ends the most live values net of the one it starts (an output store
-starts none; a load starts one), ties broken by a depth-first order from the outputs. Values
-are unchanged, only their order: the kernel gives the same bits (no statement is re-associated),
-and the batch, which runs the same statements in its own loops, still agrees with it bit for bit.
+starts none; a load starts one). Ties go to the statement with the longest chain of work still
+to run after it (:func:`_heights`: a division or square root weighs 20, a sin, cos or atan2 60,
+anything else 1, roughly their latencies in additions), so that the long chains start early and
+the processor overlaps them with the rest; then to a depth-first order from the outputs. The
+tie-break by chain length took the 3-RPR's inverse dynamics from 139 to 123 ns a call
+(revolute; 143 to 129 ns prismatic) on the benchmarks' machine; the depth-first one alone had
+kept a leg's divisions behind its whole chain. Values are unchanged, only their order: the
+kernel gives the same bits (no statement is re-associated), and the batch, which runs the same
+statements in its own loops, still agrees with it bit for bit.
 """
 
 from __future__ import annotations
@@ -47,22 +53,23 @@ def schedule(lines: Sequence[Line]) -> list[Line]:
         for d in ds:
             users[d].append(k)
     rank = _depth_first(lines, deps)
+    height = _heights(lines, users)
     remaining = [len(u) for u in users]  # users of each value not yet emitted
     waiting = [len(d) for d in deps]  # operands of each line not yet emitted
     freed = [0] * len(lines)  # operands whose last user the line is
     starts = [0 if line.kind == "store" or not users[k] else 1 for k, line in enumerate(lines)]
     emitted = [False] * len(lines)
-    heap: list[tuple[int, int, int]] = []
+    heap: list[tuple[int, int, int, int]] = []
 
     def push(k: int) -> None:
-        heapq.heappush(heap, (starts[k] - freed[k], rank[k], k))
+        heapq.heappush(heap, (starts[k] - freed[k], -height[k], rank[k], k))
 
     for k in range(len(lines)):
         if waiting[k] == 0:
             push(k)
     order: list[int] = []
     while heap:
-        key, _, k = heapq.heappop(heap)
+        key, _, _, k = heapq.heappop(heap)
         if emitted[k] or key != starts[k] - freed[k]:
             continue  # emitted already, or an entry older than the line's current key
         emitted[k] = True
@@ -80,6 +87,29 @@ def schedule(lines: Sequence[Line]) -> list[Line]:
                 push(u)
     assert len(order) == len(lines), "the kernel's statements have a cycle"
     return [lines[k] for k in order]
+
+
+#: The calls that make a statement weigh 60 in :func:`_heights` (the math kernels' names end so).
+SLOW_CALLS = ("sin(", "cos(", "atan2(")
+
+
+def _weight(line: Line) -> int:
+    """A statement's weight in :func:`_heights`: its costliest operation, in additions."""
+    text = " ".join(line.payload)
+    if any(call in text for call in SLOW_CALLS):
+        return 60
+    if "/" in text or "sqrt(" in text:
+        return 20
+    return 1
+
+
+def _heights(lines: Sequence[Line], users: list[list[int]]) -> list[int]:
+    """Per line, its weight (:func:`_weight`) plus the largest height among its users: the
+    chain of work that still waits on it. ``lines`` is in a valid order, so users come later."""
+    height = [0] * len(lines)
+    for k in range(len(lines) - 1, -1, -1):
+        height[k] = _weight(lines[k]) + max((height[u] for u in users[k]), default=0)
+    return height
 
 
 def _depth_first(lines: Sequence[Line], deps: list[list[int]]) -> list[int]:
