@@ -4,8 +4,9 @@ Cases: the gallery's symmetric 3-RRR (``models/rrr.toml``, the committed ``rrr_1
 3-RRR with base motors; the paper's robot as a general model (its twin, ``rpr_1``: lines); and
 variants generated on first use into the session's cache: ``rpr_2`` (the prismatic twin:
 circles, prismatic motors), ``prr_1`` (circles, prismatic), ``rpr_3`` (platform lines,
-revolute), ``ppr_2`` (lines, prismatic). Every hold of a locked leg with both kinds of motor but
-platform lines with prismatic motors, which ``tests/test_planar_derivation.py`` covers.
+revolute), ``ppr_2`` (lines, prismatic); and a random robot of each of the other 12 structures
+that are not architecturally singular (``rrr_2`` ... ``rpp_3``), so that the generated code of
+all 18 meets the reference, not only their derivation (``tests/test_planar_derivation.py``).
 
 Judged by the independent Newton-Euler reference (``tests/planar_reference.py``, its brute-force
 assembly modes) and by ``tests/planar_checks.py``: the parameter vector of the general format,
@@ -19,10 +20,11 @@ and the C ABI's single call against the batch, bit for bit.
 private copy of their generated folder at -O0 (the same C source, a twentieth of the compile
 time; the private folder keeps that library from every other test).
 
-Measured (seeds below): inverse dynamics within 4.7e-15 of the reference (NumPy and C, relative
-to the largest value of each unit); J, M, c within 1e-15, forward dynamics 4.3e-14, regressor
-1.4e-15; NumPy and C within 7.9e-14 on every function; 1 to 4 modes per pose, every mode of the
-reference's brute force among them (within 1.6e-12 m).
+Measured (seeds below), on the first seven cases: inverse dynamics within 4.7e-15 of the
+reference (NumPy and C, relative to the largest value of each unit); J, M, c within 1e-15,
+forward dynamics 4.3e-14, regressor 1.4e-15; NumPy and C within 7.9e-14 on every function; 1 to
+4 modes per pose, every mode of the reference's brute force among them (within 1.6e-12 m). On
+all 19 (2026-11-25, NumPy): inverse dynamics within 4.7e-15, J 1.6e-15, M 1.3e-15, c 1.1e-15.
 """
 
 from __future__ import annotations
@@ -84,6 +86,18 @@ CASES = {
     "rpr3": (functools.partial(_random, "RPR", 3, 13), "rpr_3"),
     "ppr2": (functools.partial(_random, "PPR", 2, 14), "ppr_2"),
 }
+#: Every other structure that is not architecturally singular, a random robot each: the same
+#: checks, so that the generated code of all 18 structures meets the reference.
+CASES.update(
+    {
+        f"{leg.lower()}{held}": (
+            functools.partial(_random, leg, held, 30 + k),
+            f"{leg.lower()}_{held}",
+        )
+        for k, (leg, held) in enumerate(pm.nonsingular_structures())
+        if f"{leg.lower()}_{held}" not in {variant for _, variant in CASES.values()}
+    }
+)
 NAMES = list(CASES)
 
 
