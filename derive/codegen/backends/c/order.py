@@ -16,10 +16,10 @@ to run after it (:func:`_heights`: a division or square root weighs 20, a sin, c
 anything else 1, roughly their latencies in additions), so that the long chains start early and
 the processor overlaps them with the rest; then to a depth-first order from the outputs. The
 tie-break by chain length took the 3-RPR's inverse dynamics from 139 to 123 ns a call
-(revolute; 143 to 129 ns prismatic) on the benchmarks' machine; the depth-first one alone had
-kept a leg's divisions behind its whole chain. Values are unchanged, only their order: the
-kernel gives the same bits (no statement is re-associated), and the batch, which runs the same
-statements in its own loops, still agrees with it bit for bit.
+(revolute; 143 to 129 ns prismatic) in a scratch harness on the benchmarks' machine; the
+depth-first tie-break alone follows the outputs' order, whatever the latencies. Values are
+unchanged, only their order: the kernel gives the same bits (no statement is re-associated), and
+the batch, which runs the same statements in its own loops, still agrees with it bit for bit.
 """
 
 from __future__ import annotations
