@@ -153,6 +153,7 @@ def _function(module: ModuleSpec, c: Compiled, values: bool = False) -> dict[str
         "single": signature(f"int {name}", single),
         "batch_signature": signature(f"size_t {name}_batch", batch),
         "kernel": signature(f"static int {name}_kernel", kernel),
+        "kernel_cold": signature(f"{upper}_COLD int {name}_kernel_cold", kernel),
         "sizes": sizes,
         "used_params": c.used_params,
         "used_inputs": c.used_inputs,
