@@ -18,6 +18,7 @@ import jinja2
 from rpr3gen_derive.codegen import mathkernels
 from rpr3gen_derive.codegen.backends.c import package
 from rpr3gen_derive.codegen.backends.c.batch import NotSplittableError, plan
+from rpr3gen_derive.codegen.backends.c.lanes import lanes, plain
 from rpr3gen_derive.codegen.backends.c.order import Line, schedule
 from rpr3gen_derive.codegen.backends.c.printer import c_code, fast_trig_arguments
 from rpr3gen_derive.codegen.compiled import name_tables, table_count
@@ -81,6 +82,12 @@ def _kernel_lines(
     return schedule(lines)
 
 
+def _code(lines: list[Line], param_count: int) -> list[str]:
+    """A kernel's statements as C lines: its legs as lane loops (:mod:`.lanes`) when it has
+    enough statements to share them, else one statement after the other."""
+    return lanes(lines, param_count) or plain(lines)
+
+
 def _needed(lines: list[Line]) -> list[Line]:
     """The stores of ``lines`` and the lines they read, transitively, in order."""
     defined = {x.name: x for x in lines if x.name}
@@ -105,6 +112,7 @@ def _function(module: ModuleSpec, c: Compiled, values: bool = False) -> dict[str
     except NotSplittableError:  # the batch loops over the kernel instead
         p = None
     slot = dict(enumerate(c.slots))
+    count = len(module.params.symbols)
 
     def outputs(indexed: Any, fast: bool = False) -> list[tuple[str, int, str]]:
         return [(*slot[k], c_code(e, prefix, fast)) for k, e in indexed]
@@ -158,9 +166,14 @@ def _function(module: ModuleSpec, c: Compiled, values: bool = False) -> dict[str
         "used_params": c.used_params,
         "used_inputs": c.used_inputs,
         "assignments": _lines(c.code.assignments, prefix),
-        "kernel_lines": _kernel_lines(c, prefix, outputs(enumerate(e for _, e in c.code.outputs))),
+        "kernel_lines": _code(
+            _kernel_lines(c, prefix, outputs(enumerate(e for _, e in c.code.outputs))), count
+        ),
         "values_lines": (
-            _kernel_lines(c, prefix, outputs(enumerate(e for _, e in c.code.outputs)), True)
+            _code(
+                _kernel_lines(c, prefix, outputs(enumerate(e for _, e in c.code.outputs)), True),
+                count,
+            )
             if values
             else None
         ),

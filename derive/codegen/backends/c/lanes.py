@@ -1,0 +1,273 @@
+"""The legs side by side: a single-sample kernel's leg statements as loops over 4 lanes.
+
+The three legs are independent until the platform's equations: leg B's kinematics are leg A's
+statements with B's parameters. Written one leg after the other, a single call is a chain of
+~1,500 scalar instructions; written as ``for (i = 0; i < 4; ++i)`` over the legs, gcc's loop
+vectoriser runs the three legs as lanes of one 4-wide vector (lane 3 is padding), so a call
+runs about a third of those instructions for the legs' part (issue 20: the revolute inverse
+dynamics 123 -> 108 ns, forward dynamics 96 -> 72 ns in a scratch harness).
+
+:func:`lanes` finds the lane groups: three statements, one per leg, that are the same
+expression once each operand that is itself a lane group's member is read as the group's
+(a leg's parameters: three loads ``params[k0]``, ``params[k0 + d]``, ``params[k0 + 2 d]`` whose
+names differ only by the leg's letter). "The same expression" is exact: the expressions' trees
+are equal up to swapping the two operands of an addition or a multiplication, which IEEE 754
+computes to the same bits; a lane therefore gives its leg the same bits as the scalar statement
+would, and the batch (which runs the scalar statements) still agrees with the single call bit
+for bit. The kernel is then cut into phases, scalar statements and lane loops alternately, each
+taking every statement whose operands an earlier phase computed, in the scheduler's order
+(:mod:`.order`). A lane value read after its loop is kept in an array of 4 and read back just
+before its first reader as the leg's scalar (``const double rx_B = rx_legs[1];``).
+
+Lane 3 loads ``params[k0 + 3 d]`` (checked to lie inside the parameter vector): an unrelated
+parameter, so its values mean nothing and are never read. Its arithmetic can raise
+floating-point exception flags the three legs would not raise; the library is built with
+``-fno-trapping-math`` and does not support running with floating-point traps enabled.
+"""
+
+from __future__ import annotations
+
+import ast
+import re
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+from rpr3gen_derive.codegen.backends.c.order import Line
+
+LEGS = "ABC"
+#: Lanes per loop: the legs, padded to a 4-wide vector of doubles.
+WIDTH = 4
+#: Fewest lane groups that make a function's loops worth their overhead.
+MIN_GROUPS = 4
+
+_INDEX = re.compile(r"params\[(\d+)\]$")
+_NAME = re.compile(r"\b[A-Za-z_]\w*\b")
+
+
+@dataclass(frozen=True)
+class _Group:
+    """Three statements, one per leg (``members[k]`` for ``LEGS[k]``), run as one lane loop."""
+
+    members: tuple[Line, Line, Line]
+    name: str  # the loop's name for the value (the members' name with the leg as ``i``)
+    text: str  # the loop's statement text
+
+
+def _leg_family(names: Sequence[str], name: str) -> tuple[str, str, str, str] | None:
+    """``(pattern, a, b, c)`` when ``name`` is leg A's of three names that differ only by the
+    leg's letter at one place (``xA1``, ``xB1``, ``xC1``; ``rx_A``, ``rx_B``, ``rx_C``)."""
+    known = set(names)
+    for k, ch in enumerate(name):
+        if ch != "A":
+            continue
+        others = [name[:k] + leg + name[k + 1 :] for leg in "BC"]
+        if all(o in known for o in others):
+            return name[:k] + "i" + name[k + 1 :], name, others[0], others[1]
+    return None
+
+
+def _canonical(node: ast.AST, rename: dict[str, str]) -> str:
+    """``node`` as text with names renamed and the operands of every addition and
+    multiplication sorted (the forms IEEE 754 computes to the same bits)."""
+    if isinstance(node, ast.BinOp):
+        left, right = _canonical(node.left, rename), _canonical(node.right, rename)
+        op = type(node.op).__name__
+        if op in ("Add", "Mult") and right < left:
+            left, right = right, left
+        return f"({left} {op} {right})"
+    if isinstance(node, ast.UnaryOp):
+        return f"({type(node.op).__name__} {_canonical(node.operand, rename)})"
+    if isinstance(node, ast.Call):
+        args = ", ".join(_canonical(a, rename) for a in node.args)
+        return f"{_canonical(node.func, rename)}({args})"
+    if isinstance(node, ast.Name):
+        return rename.get(node.id, node.id)
+    if isinstance(node, ast.Constant):
+        return repr(node.value)
+    raise ValueError(f"not a kernel expression: {ast.dump(node)}")
+
+
+def _parse(text: str) -> ast.AST | None:
+    try:
+        return ast.parse(text, mode="eval").body
+    except SyntaxError:  # C only (a ternary, a cast): stays scalar
+        return None
+
+
+def _groups(lines: Sequence[Line], param_count: int) -> dict[str, tuple[int, int]]:
+    """Lane groups: each member's name -> (group, leg), found to a fixed point."""
+    names = [x.name for x in lines if x.name]
+    member: dict[str, tuple[int, int]] = {}
+    count = 0
+    for line in lines:  # a leg's parameters: an arithmetic progression inside params
+        family = _leg_family(names, line.name) if line.kind == "load" else None
+        if family is None:
+            continue
+        by_name = {x.name: x for x in lines}
+        index = [_INDEX.match(by_name[n].payload[0]) for n in family[1:]]
+        if not all(index):
+            continue
+        k0, k1, k2 = (int(m.group(1)) for m in index if m)
+        if k1 - k0 == k2 - k1 != 0 and 0 <= k0 + 3 * (k1 - k0) < param_count:
+            for leg, n in enumerate(family[1:]):
+                member[n] = (count, leg)
+            count += 1
+    trees = {x.name: _parse(x.payload[0]) for x in lines if x.kind == "assign"}
+    while True:  # a group can make the statements that read it groups: repeat until none new
+        found: dict[str, dict[int, str]] = {}
+        for line in lines:
+            tree = trees.get(line.name)
+            if line.kind != "assign" or line.name in member or tree is None:
+                continue
+            legs = {member[r][1] for r in line.reads if r in member}
+            if len(legs) != 1:
+                continue
+            rename = {r: f"@{member[r][0]}" for r in line.reads if r in member}
+            key = _canonical(tree, rename)
+            found.setdefault(key, {}).setdefault(legs.pop(), line.name)
+        new = [three for three in found.values() if len(three) == len(LEGS)]
+        if not new:
+            return member
+        for three in new:
+            for leg, n in three.items():
+                member[n] = (count, leg)
+            count += 1
+
+
+def lanes(lines: Sequence[Line], param_count: int, indent: str = "    ") -> list[str] | None:
+    """The kernel's statements (in the scheduler's order) as C lines, the leg statements as lane
+    loops; None when the kernel has fewer than :data:`MIN_GROUPS` lane groups."""
+    member = _groups(lines, param_count)
+    found: dict[int, list[Line]] = {}
+    for line in lines:
+        if line.name in member:
+            found.setdefault(member[line.name][0], []).append(line)
+    if len(found) < MIN_GROUPS:
+        return None
+    groups = _named(found, member, {x.name for x in lines if x.name} | {"i"})
+    # units in the scheduler's order: a group stands where its first member stood
+    units: list[Line | _Group] = []
+    for line in lines:
+        if line.name not in member:
+            units.append(line)
+        elif line is groups[member[line.name][0]].members[member[line.name][1]] and all(
+            u is not groups[member[line.name][0]] for u in units
+        ):
+            units.append(groups[member[line.name][0]])
+    phase = _phases(units)
+    where = {x.name: phase[u] for u, unit in enumerate(units) for x in _lines_of(unit) if x.name}
+    kept = {  # groups whose values a later phase reads: kept in arrays
+        member[r][0]
+        for u, unit in enumerate(units)
+        for x in _lines_of(unit)
+        for r in x.reads
+        if r in member and where[r] != phase[u]
+    }
+    out = [indent + "int i;"]
+    out += [
+        f"{indent}double {groups[g].name}_legs[{WIDTH}];"
+        for g in sorted(kept, key=lambda g: groups[g].name)
+    ]
+    unpacked: set[str] = set()
+    for p in range(max(phase) + 1):
+        here = [unit for u, unit in enumerate(units) if phase[u] == p]
+        if p % 2 == 0:  # scalar statements, reading kept lane values as their legs' scalars
+            for unit in here:
+                assert isinstance(unit, Line)
+                for r in sorted(unit.reads & member.keys() - unpacked):
+                    g, leg = member[r]
+                    out.append(f"{indent}const double {r} = {groups[g].name}_legs[{leg}];")
+                    unpacked.add(r)
+                out.extend(plain([unit], indent))
+            continue
+        if not here:
+            continue
+        out.append(f"{indent}for (i = 0; i < {WIDTH}; ++i) {{ /* legs A, B, C; lane 3 unused */")
+        for unit in here:
+            assert isinstance(unit, _Group)
+            text = _lane_text(unit, member, groups, where, p)
+            out.append(f"{indent}    const double {unit.name} = {text};")
+            if member[unit.members[0].name][0] in kept:
+                out.append(f"{indent}    {unit.name}_legs[i] = {unit.name};")
+        out.append(indent + "}")
+    return out
+
+
+def _named(
+    found: dict[int, list[Line]], member: dict[str, tuple[int, int]], taken: set[str]
+) -> dict[int, _Group]:
+    """Each group with its loop's name for the value: the members' with the leg as ``i``
+    (``rx_A`` -> ``rx_i``, ``xA1`` -> ``xi1``), else leg A's with ``_i`` (``x0`` -> ``x0_i``)."""
+    groups = {}
+    for g, three in found.items():
+        a, b, c = sorted(three, key=lambda x: member[x.name][1])
+        family = _leg_family([a.name, b.name, c.name], a.name)
+        name = family[0] if family else f"{a.name}_i"
+        while name in taken:  # e.g. x2_A's family and the temporary x2 both make x2_i
+            name += "_"
+        taken.add(name)
+        groups[g] = _Group((a, b, c), name, a.payload[0])
+    return groups
+
+
+def _lines_of(unit: Line | _Group) -> tuple[Line, ...]:
+    return unit.members if isinstance(unit, _Group) else (unit,)
+
+
+def _phases(units: Sequence[Line | _Group]) -> list[int]:
+    """Per unit, its phase: even phases are scalar statements, odd ones lane loops; each phase
+    takes every unit of its kind whose operands earlier units computed (to a fixed point)."""
+    defined_by = {x.name: u for u, unit in enumerate(units) for x in _lines_of(unit) if x.name}
+    deps = [
+        {defined_by[r] for x in _lines_of(unit) for r in x.reads if r in defined_by} - {u}
+        for u, unit in enumerate(units)
+    ]
+    phase = [-1] * len(units)
+    p = 0
+    while min(phase, default=0) < 0:
+        assert p <= 2 * len(units), "the kernel's statements have a cycle"
+        grew = True
+        while grew:
+            grew = False
+            for u, unit in enumerate(units):
+                ready = all(phase[d] >= 0 for d in deps[u])
+                if phase[u] < 0 and isinstance(unit, _Group) == (p % 2 == 1) and ready:
+                    phase[u] = p
+                    grew = True
+        p += 1
+    return phase
+
+
+def _lane_text(
+    group: _Group,
+    member: dict[str, tuple[int, int]],
+    groups: dict[int, _Group],
+    where: dict[str, int],
+    p: int,
+) -> str:
+    """Leg A's statement for lane ``i``: a parameter as ``params[k0 + d*i]``, a group's value
+    as the loop's local (same loop) or its array's lane (an earlier loop)."""
+    a, b, _ = group.members
+    first, second = _INDEX.match(a.payload[0]), _INDEX.match(b.payload[0])
+    if a.kind == "load" and first and second:
+        k0 = int(first.group(1))
+        return f"params[{k0} + {int(second.group(1)) - k0}*i]"
+
+    def local(m: re.Match[str]) -> str:
+        n = m.group(0)
+        if n not in member or member[n][1] != 0:
+            return n
+        other = groups[member[n][0]]
+        return other.name if where[n] == p else f"{other.name}_legs[i]"
+
+    return _NAME.sub(local, group.text)
+
+
+def plain(lines: Sequence[Line], indent: str = "    ") -> list[str]:
+    """The kernel's statements as C lines, one after the other."""
+    return [
+        f"{indent}r_{x.payload[0]}[{x.payload[1]}] = {x.payload[2]};"
+        if x.kind == "store"
+        else f"{indent}const double {x.name} = {x.payload[0]};"
+        for x in lines
+    ]
