@@ -37,12 +37,21 @@ LIBM = ("sin", "cos", "sqrt", "atan2")
 
 
 def kernel_calls(source: str, prefix: str) -> dict[str, dict[str, int]]:
-    """libm calls (or the generated kernels standing for them) in each ``PREFIX_NAME_kernel``."""
+    """libm calls (or the generated kernels standing for them) in each ``PREFIX_NAME_kernel``,
+    per sample: a call inside a loop over the legs (``derive/codegen/backends/c/lanes.py``)
+    counts once per leg."""
     calls = {}
     for match in re.finditer(rf"^static int {prefix}_(\w+)_kernel\(", source, re.M):
-        end = source.find(f"\nint {prefix}_", match.start())
-        body = source[match.start() : end if end > 0 else None]
-        found = {f: len(re.findall(rf"(?:\b|\b{prefix}_){f}(?:_fast)?\(", body)) for f in LIBM}
+        body = source[match.start() : source.index("\n}\n", match.start())]
+        found = dict.fromkeys(LIBM, 0)
+        legs = 1
+        for line in body.splitlines():
+            if line.lstrip().startswith("for (i = 0; i < 4; ++i)"):
+                legs = 3
+            elif line == "    }":
+                legs = 1
+            for f in LIBM:
+                found[f] += legs * len(re.findall(rf"(?:\b|\b{prefix}_){f}(?:_fast)?\(", line))
         calls[match.group(1)] = {f: k for f, k in found.items() if k}
     return calls
 
