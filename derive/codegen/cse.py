@@ -3,7 +3,7 @@
 The program's right-hand sides and a function's outputs are passed to ``sympy.cse`` together,
 in program order, with ``order="canonical"``; the result is a straight-line list of assignments
 in which every temporary comes right before its first use. Assignments that no output needs are
-dropped.
+dropped. The temporaries of one leg are then named after leg A's (:mod:`.legnames`).
 """
 
 from __future__ import annotations
@@ -13,6 +13,7 @@ from dataclasses import dataclass
 from functools import lru_cache
 
 import sympy as sp
+from rpr3gen_derive.codegen.legnames import leg_names
 from rpr3gen_derive.codegen.program import Program
 
 
@@ -54,8 +55,11 @@ def _live(
     return live
 
 
-def straight_line(program: Program, outputs: Sequence[tuple[str, sp.Expr]]) -> StraightLine:
-    """Eliminate common subexpressions across ``program`` and the ``(label, expr)`` outputs."""
+def straight_line(
+    program: Program, outputs: Sequence[tuple[str, sp.Expr]], reserved: frozenset[str] = frozenset()
+) -> StraightLine:
+    """Eliminate common subexpressions across ``program`` and the ``(label, expr)`` outputs;
+    ``reserved``: names a renamed temporary must not take (the parameters', the inputs')."""
     live = _live(program, outputs)
     exprs = [expr for _, expr in live] + [expr for _, expr in outputs]
     ops_before = count_ops(exprs)
@@ -81,5 +85,6 @@ def straight_line(program: Program, outputs: Sequence[tuple[str, sp.Expr]]) -> S
     for (name, _), expr in zip(outputs, reduced[len(live) :], strict=True):
         emit_temps_of(expr)
         result.append((name, expr))
+    lines, result = leg_names(lines, result, set(temp_defs), reserved)
     ops_after = count_ops([expr for _, expr in lines] + [expr for _, expr in result])
     return StraightLine(tuple(lines), tuple(result), ops_before, ops_after)

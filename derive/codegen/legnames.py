@@ -1,0 +1,108 @@
+"""Per-leg names for the CSE temporaries, so that every leg prints its statements alike.
+
+``sympy.cse`` numbers its temporaries in the order it meets them: leg A's ``x38`` is leg B's
+``x50``. The printers order a sum's terms by the names in them, so the same sum of two legs can
+print as ``(a + x38) + b*x6`` and ``(a + b*x20) + x50``. Those round differently, so the C
+backend cannot run them as lanes of one vector (:mod:`.backends.c.lanes`). :func:`leg_names`
+renames three temporaries that are one expression for the three legs to ``x38_A``, ``x38_B``,
+``x38_C`` (leg A's number). Then every name of leg B compares to the expression's other names as
+leg A's does, and the legs print their sums in one order.
+
+A leg's symbols are the program's: names that differ only by the leg's letter at one place
+(``xA1``, ``xB1``, ``xC1``; ``rx_A``, ``rx_B``, ``rx_C``). A temporary belongs to one leg when the
+leg's symbols are the only leg symbols it reads, directly or through temporaries renamed before
+it; the renaming runs to a fixed point. Names change, not values: the expressions are the same.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Sequence
+
+import sympy as sp
+
+LEGS = "ABC"
+
+
+def _families(names: Iterable[str]) -> dict[str, tuple[str, int]]:
+    """Each leg symbol's name -> (its family's pattern, its leg)."""
+    known = set(names)
+    found: dict[str, tuple[str, int]] = {}
+    for name in sorted(known):
+        for k, ch in enumerate(name):
+            if ch != "A":
+                continue
+            three = [name[:k] + leg + name[k + 1 :] for leg in LEGS]
+            if all(n in known for n in three):
+                for leg, n in enumerate(three):
+                    found.setdefault(n, (name[:k] + "@" + name[k + 1 :], leg))
+                break
+    return found
+
+
+def leg_names(
+    lines: Sequence[tuple[sp.Symbol, sp.Expr]],
+    outputs: Sequence[tuple[str, sp.Expr]],
+    temporaries: set[sp.Symbol],
+    reserved: frozenset[str] = frozenset(),
+) -> tuple[list[tuple[sp.Symbol, sp.Expr]], list[tuple[str, sp.Expr]]]:
+    """``lines`` and ``outputs`` with the leg temporaries renamed (see the module). A new name
+    is never one of ``reserved`` (every parameter's and input's, used here or not) or of a
+    symbol here."""
+    symbols: set[sp.Symbol] = set()
+    for sym, expr in lines:
+        symbols |= {sym} | expr.free_symbols
+    for _, expr in outputs:
+        symbols |= expr.free_symbols
+    names = {str(s) for s in symbols} | set(reserved)
+    temp_names = {str(t) for t in temporaries}
+    family = _families(n for n in names if n not in temp_names)
+    leg_of: dict[sp.Symbol, tuple[str, int]] = {
+        s: family[str(s)] for s in symbols if str(s) in family
+    }
+    rename: dict[sp.Symbol, sp.Symbol] = {}
+    pending = {sym: expr for sym, expr in lines if sym in temporaries}
+    readers: dict[sp.Symbol, list[sp.Symbol]] = {}
+    reads = {sym: expr.free_symbols for sym, expr in pending.items()}
+    for sym, free in reads.items():
+        for s in free:
+            readers.setdefault(s, []).append(sym)
+    keyed: dict[sp.Symbol, sp.Expr] = {}  # a temporary's current key (one leg only)
+    index: dict[sp.Expr, dict[int, sp.Symbol]] = {}  # key -> leg -> temporary
+    dirty = list(pending)
+    while dirty:  # each pass looks again only at the readers of what the last one renamed
+        touched: list[sp.Expr] = []
+        for sym in dirty:
+            old = keyed.pop(sym, None)
+            if old is not None:
+                index[old] = {g: t for g, t in index[old].items() if t != sym}
+            legs = {leg_of[s][1] for s in reads[sym] if s in leg_of}
+            if len(legs) != 1:
+                continue
+            key = pending[sym].xreplace(
+                {s: sp.Symbol("@" + leg_of[s][0]) for s in reads[sym] if s in leg_of}
+            )
+            keyed[sym] = key
+            index.setdefault(key, {}).setdefault(legs.pop(), sym)
+            touched.append(key)
+        grouped: list[sp.Symbol] = []
+        for key in dict.fromkeys(touched):
+            three = index.get(key, {})
+            if len(three) != len(LEGS) or any(t in rename for t in three.values()):
+                continue
+            base = str(three[0])
+            targets = [f"{base}_{leg}" for leg in LEGS]
+            if any(t in names for t in targets):
+                continue
+            for leg, sym in three.items():
+                leg_of[sym] = (f"{base}_@", leg)
+                rename[sym] = sp.Symbol(targets[leg], real=True)
+                names.add(targets[leg])
+                grouped.append(sym)
+        done = set(rename)
+        dirty = list(dict.fromkeys(r for g in grouped for r in readers.get(g, []) if r not in done))
+    if not rename:
+        return list(lines), list(outputs)
+    return (
+        [(rename.get(s, s), e.xreplace(rename)) for s, e in lines],
+        [(n, e.xreplace(rename)) for n, e in outputs],
+    )
