@@ -1,11 +1,11 @@
 """The legs side by side: a single-sample kernel's leg statements as loops over 4 lanes.
 
 The three legs are independent until the platform's equations: leg B's kinematics are leg A's
-statements with B's parameters. Written one leg after the other, a single call is a chain of
-~1,500 scalar instructions; written as ``for (i = 0; i < 4; ++i)`` over the legs, gcc's loop
-vectoriser runs the three legs as lanes of one 4-wide vector (lane 3 is padding), so a call
-runs about a third of those instructions for the legs' part (issue 20: the revolute inverse
-dynamics 123 -> 108 ns, forward dynamics 96 -> 72 ns in a scratch harness).
+statements with B's parameters. Written one leg after the other, the inverse dynamics' single
+call was ~1,650 instructions; written as ``for (i = 0; i < 4; ++i)`` over the legs, gcc's loop
+vectoriser runs the three legs as lanes of one 4-wide vector (lane 3 is padding), and the call
+is ~1,170 (issue 20, full benchmark runs: revolute 123 -> 107 ns, forward dynamics 96 -> 75 ns;
+with the per-leg names of :mod:`rpr3gen_derive.codegen.legnames`, 97 ns).
 
 :func:`lanes` finds the lane groups: three statements, one per leg, that are the same
 expression once each operand that is itself a lane group's member is read as the group's
