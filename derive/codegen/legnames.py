@@ -17,10 +17,21 @@ it; the renaming runs to a fixed point. Names change, not values: the expression
 from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
+from collections.abc import Set as AbstractSet
 
 import sympy as sp
 
 LEGS = "ABC"
+
+
+def leg_family(name: str, known: AbstractSet[str]) -> tuple[str, str] | None:
+    """``(head, tail)`` when ``name`` is leg A's of three names in ``known`` that differ only by
+    the leg's letter at one place: ``head + leg + tail`` (``xA1``, ``xB1``, ``xC1``; ``rx_A``,
+    ``rx_B``, ``rx_C``). The C backend's lanes (:mod:`.backends.c.lanes`) use it too."""
+    for k, ch in enumerate(name):
+        if ch == "A" and all(name[:k] + leg + name[k + 1 :] in known for leg in LEGS[1:]):
+            return name[:k], name[k + 1 :]
+    return None
 
 
 def _families(names: Iterable[str]) -> dict[str, tuple[str, int]]:
@@ -28,14 +39,11 @@ def _families(names: Iterable[str]) -> dict[str, tuple[str, int]]:
     known = set(names)
     found: dict[str, tuple[str, int]] = {}
     for name in sorted(known):
-        for k, ch in enumerate(name):
-            if ch != "A":
-                continue
-            three = [name[:k] + leg + name[k + 1 :] for leg in LEGS]
-            if all(n in known for n in three):
-                for leg, n in enumerate(three):
-                    found.setdefault(n, (name[:k] + "@" + name[k + 1 :], leg))
-                break
+        family = leg_family(name, known)
+        if family is not None:
+            head, tail = family
+            for leg, letter in enumerate(LEGS):
+                found.setdefault(head + letter + tail, (head + "@" + tail, leg))
     return found
 
 

@@ -33,8 +33,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 from rpr3gen_derive.codegen.backends.c.order import Line
+from rpr3gen_derive.codegen.legnames import LEGS, leg_family
 
-LEGS = "ABC"
 #: Lanes per loop: the legs, padded to a 4-wide vector of doubles.
 WIDTH = 4
 #: Fewest lane groups that make a function's loops worth their overhead.
@@ -50,20 +50,6 @@ class _Group:
 
     members: tuple[Line, Line, Line]
     name: str  # the loop's name for the value (the members' name with the leg as ``i``)
-    text: str  # the loop's statement text
-
-
-def _leg_family(names: Sequence[str], name: str) -> tuple[str, str, str, str] | None:
-    """``(pattern, a, b, c)`` when ``name`` is leg A's of three names that differ only by the
-    leg's letter at one place (``xA1``, ``xB1``, ``xC1``; ``rx_A``, ``rx_B``, ``rx_C``)."""
-    known = set(names)
-    for k, ch in enumerate(name):
-        if ch != "A":
-            continue
-        others = [name[:k] + leg + name[k + 1 :] for leg in "BC"]
-        if all(o in known for o in others):
-            return name[:k] + "i" + name[k + 1 :], name, others[0], others[1]
-    return None
 
 
 def _canonical(node: ast.AST, rename: dict[str, str]) -> str:
@@ -96,20 +82,21 @@ def _parse(text: str) -> ast.AST | None:
 
 def _groups(lines: Sequence[Line], param_count: int) -> dict[str, tuple[int, int]]:
     """Lane groups: each member's name -> (group, leg), found to a fixed point."""
-    names = [x.name for x in lines if x.name]
+    by_name = {x.name: x for x in lines if x.name}
     member: dict[str, tuple[int, int]] = {}
     count = 0
     for line in lines:  # a leg's parameters: an arithmetic progression inside params
-        family = _leg_family(names, line.name) if line.kind == "load" else None
+        family = leg_family(line.name, by_name.keys()) if line.kind == "load" else None
         if family is None:
             continue
-        by_name = {x.name: x for x in lines}
-        index = [_INDEX.match(by_name[n].payload[0]) for n in family[1:]]
+        head, tail = family
+        loads = [head + leg + tail for leg in LEGS]
+        index = [_INDEX.match(by_name[n].payload[0]) for n in loads]
         if not all(index):
             continue
         k0, k1, k2 = (int(m.group(1)) for m in index if m)
         if k1 - k0 == k2 - k1 != 0 and 0 <= k0 + 3 * (k1 - k0) < param_count:
-            for leg, n in enumerate(family[1:]):
+            for leg, n in enumerate(loads):
                 member[n] = (count, leg)
             count += 1
     trees = {x.name: _parse(x.payload[0]) for x in lines if x.kind == "assign"}
@@ -147,12 +134,12 @@ def lanes(lines: Sequence[Line], param_count: int, indent: str = "    ") -> list
     groups = _named(found, member, {x.name for x in lines if x.name} | {"i"})
     # units in the scheduler's order: a group stands where its first member stood
     units: list[Line | _Group] = []
+    placed: set[int] = set()
     for line in lines:
         if line.name not in member:
             units.append(line)
-        elif line is groups[member[line.name][0]].members[member[line.name][1]] and all(
-            u is not groups[member[line.name][0]] for u in units
-        ):
+        elif member[line.name][0] not in placed:
+            placed.add(member[line.name][0])
             units.append(groups[member[line.name][0]])
     phase = _phases(units)
     where = {x.name: phase[u] for u, unit in enumerate(units) for x in _lines_of(unit) if x.name}
@@ -201,12 +188,12 @@ def _named(
     groups = {}
     for g, three in found.items():
         a, b, c = sorted(three, key=lambda x: member[x.name][1])
-        family = _leg_family([a.name, b.name, c.name], a.name)
-        name = family[0] if family else f"{a.name}_i"
+        family = leg_family(a.name, {a.name, b.name, c.name})
+        name = family[0] + "i" + family[1] if family else f"{a.name}_i"
         while name in taken:  # e.g. x2_A's family and the temporary x2 both make x2_i
             name += "_"
         taken.add(name)
-        groups[g] = _Group((a, b, c), name, a.payload[0])
+        groups[g] = _Group((a, b, c), name)
     return groups
 
 
@@ -260,7 +247,7 @@ def _lane_text(
         other = groups[member[n][0]]
         return other.name if where[n] == p else f"{other.name}_legs[i]"
 
-    return _NAME.sub(local, group.text)
+    return _NAME.sub(local, a.payload[0])
 
 
 def plain(lines: Sequence[Line], indent: str = "    ") -> list[str]:
