@@ -188,10 +188,8 @@ def joint_loads(
     det = prog.define("det_W", W.det(method="bareiss"), STEP_CLOSURE)
     inv_det = prog.define("inv_det_W", 1 / det, STEP_CLOSURE)
     adjugate = W.adjugate()
-    inverse = sp.Matrix(
-        3,
-        3,
-        lambda i, j: prog.define(f"Winv_{i + 1}{j + 1}", adjugate[i, j] * inv_det, STEP_CLOSURE),
+    cofactors = sp.Matrix(
+        3, 3, lambda i, j: prog.define(f"adjW_{i + 1}{j + 1}", adjugate[i, j], STEP_CLOSURE)
     )
     power = {
         (leg, m.name): prog.define(f"P{m.name}{tag}_{leg}", m.power, STEP_CLOSURE)
@@ -232,16 +230,31 @@ def joint_loads(
         v = kin.to_frame((t[0] + t[2] * turn[0], t[1] + t[2] * turn[1]))
         return (v[0], v[1], t[2])
 
+    # The free velocities are linear in the twist t = Winv[:, i] of the loads of leg i, and so
+    # is their virtual power: sum_other sum_f v_f P_f = h . t, h the platform-twist image of the
+    # free joints' powers (the adjoint of eq. 7, one 3-vector for all nine brackets). Then
+    # Q_i = Winv[:, i] . h = (adj(W)[:, i] . h) / det(W): the characteristic virtual velocities
+    # of eq. (8) are never formed one by one.
+    twist = sp.symbols("t1:4", real=True)
+    parts: list[list[sp.Expr]] = [[], [], []]
+    for other in legs:
+        values = free_velocities(other, twist_at(other, sp.Matrix(twist)))
+        power_of = sp.expand(
+            sum(
+                (v * power[(other, f)] for f, v in zip(free[other], values, strict=True)),
+                sp.Integer(0),
+            )
+        )
+        for k in range(3):
+            part = reduce_units(power_of.coeff(twist[k]), kinematics[other].pose.units)
+            parts[k].append(prog.define(f"h{k + 1}{tag}_{other}", part, STEP_VIRTUAL))
+    h = [
+        prog.define(f"h{k + 1}{tag}", sum(parts[k], sp.Integer(0)), STEP_VIRTUAL) for k in range(3)
+    ]
     bracket: dict[str, sp.Expr] = {}
     for i, leg in enumerate(legs):
-        unit_twist = inverse[:, i]
-        total = sp.Integer(0)
-        for other in legs:
-            values = free_velocities(other, twist_at(other, unit_twist))
-            for f, velocity in zip(free[other], values, strict=True):
-                v = prog.define(f"v{f}{tag}_{leg}__{other}", velocity, STEP_VIRTUAL)
-                total = total + v * power[(other, f)]
-        bracket[leg] = prog.define(f"Q{tag}_{leg}", total, STEP_VIRTUAL)
+        column = sum((cofactors[k, i] * h[k] for k in range(3)), sp.Integer(0))
+        bracket[leg] = prog.define(f"Q{tag}_{leg}", inv_det * column, STEP_VIRTUAL)
 
     loads: dict[tuple[str, int], JointLoad] = {}
     for leg in legs:
