@@ -235,7 +235,7 @@ def joint_loads(
     # free joints' powers (the adjoint of eq. 7, one 3-vector for all nine brackets). Then
     # Q_i = Winv[:, i] . h = (adj(W)[:, i] . h) / det(W): the characteristic virtual velocities
     # of eq. (8) are never formed one by one.
-    twist = sp.symbols("t1:4", real=True)
+    twist = sp.symbols("t1:4", real=True, cls=sp.Dummy)  # never a parameter's name
     parts: list[list[sp.Expr]] = [[], [], []]
     for other in legs:
         values = free_velocities(other, twist_at(other, sp.Matrix(twist)))
