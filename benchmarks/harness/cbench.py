@@ -23,6 +23,9 @@ import tempfile
 from pathlib import Path
 from typing import Any
 
+from rpr3gen_derive.codegen.backends.c.lanes import LOOP
+from rpr3gen_derive.codegen.legnames import LEGS
+
 from harness import samples
 from rpr3gen import cbackend
 from rpr3gen.manifest import FunctionInfo
@@ -44,12 +47,12 @@ def kernel_calls(source: str, prefix: str) -> dict[str, dict[str, int]]:
     for match in re.finditer(rf"^static int {prefix}_(\w+)_kernel\(", source, re.M):
         body = source[match.start() : source.index("\n}\n", match.start())]
         found = dict.fromkeys(LIBM, 0)
-        legs = 1
+        legs, close = 1, None  # inside a lane loop: its calls run once per leg
         for line in body.splitlines():
-            if line.lstrip().startswith("for (i = 0; i < 4; ++i)"):
-                legs = 3
-            elif line == "    }":
-                legs = 1
+            if line.strip() == LOOP:
+                legs, close = len(LEGS), line[: len(line) - len(line.lstrip())] + "}"
+            elif line == close:
+                legs, close = 1, None
             for f in LIBM:
                 found[f] += legs * len(re.findall(rf"(?:\b|\b{prefix}_){f}(?:_fast)?\(", line))
         calls[match.group(1)] = {f: k for f, k in found.items() if k}

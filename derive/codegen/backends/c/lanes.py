@@ -37,6 +37,9 @@ from rpr3gen_derive.codegen.legnames import LEGS, leg_family
 
 #: Lanes per loop: the legs, padded to a 4-wide vector of doubles.
 WIDTH = 4
+#: How every lane loop opens (readers of the generated C, e.g. the benchmark's floor, find the
+#: loops by it); the loop closes at the first ``}`` back at this line's indent.
+LOOP = f"for (i = 0; i < {WIDTH}; ++i) {{ /* legs A, B, C; lane 3 unused */"
 #: Fewest lane groups that make a function's loops worth their overhead.
 MIN_GROUPS = 4
 
@@ -169,7 +172,7 @@ def lanes(lines: Sequence[Line], param_count: int, indent: str = "    ") -> list
             continue
         if not here:
             continue
-        out.append(f"{indent}for (i = 0; i < {WIDTH}; ++i) {{ /* legs A, B, C; lane 3 unused */")
+        out.append(indent + LOOP)
         for unit in here:
             assert isinstance(unit, _Group)
             text = _lane_text(unit, member, groups, where, p)
