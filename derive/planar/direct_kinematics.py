@@ -122,11 +122,34 @@ def locked_kind(kinds: str, actuated: int) -> str:
     return {"RR": "circle", "PR": "line", "RP": "platform_line", "PP": "angle"}[free]
 
 
-@lru_cache(maxsize=1024)
+LEG_LETTERS = "".join(LEGS)
+
+
 def _simple(expr: sp.Expr) -> sp.Expr:
     """Small constraint data, simplified (the paper's parameters give cos^2 + sin^2 and sums
-    of angles that SymPy only sees through trigsimp). Memoised: the legs' data repeat, and
-    trigsimp is slow."""
+    of angles that SymPy only sees through trigsimp).
+
+    trigsimp is slow (it was most of a variant's derivation), and the three legs' data are one
+    expression in their own symbols. So one leg's expression is simplified as leg A's: each
+    symbol named with leg B's (or C's) letter, and no other leg letter, is renamed to leg A's,
+    the result memoised and renamed back. Where the renaming would not be one to one (an
+    expression of several legs), the expression is simplified as it is.
+    """
+    to_a: dict[sp.Symbol, sp.Symbol] = {}
+    for s in expr.free_symbols:
+        letters = [ch for ch in s.name if ch in LEG_LETTERS] if type(s) is sp.Symbol else []
+        if len(letters) == 1 and letters[0] != LEG_LETTERS[0]:
+            to_a[s] = sp.Symbol(s.name.replace(letters[0], LEG_LETTERS[0]), **s.assumptions0)
+    renamed = set(to_a.values())
+    if not to_a or len(renamed) < len(to_a) or renamed & expr.free_symbols:
+        return _simplified(expr)
+    back = {a: s for s, a in to_a.items()}
+    return _simplified(expr.xreplace(to_a)).xreplace(back)
+
+
+@lru_cache(maxsize=1024)
+def _simplified(expr: sp.Expr) -> sp.Expr:
+    """:func:`_simple`'s work, memoised."""
     return sp.trigsimp(sp.expand(expr))
 
 
