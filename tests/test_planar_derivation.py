@@ -28,6 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import pytest
+import sympy as sp
 from rpr3gen_derive.codegen.program import Program
 from rpr3gen_derive.planar import control, direct_kinematics, general, identification, registry
 from rpr3gen_derive.planar import structures as st
@@ -421,3 +422,24 @@ def test_regressor_reproduces_the_efforts(kinds: str, actuated: int) -> None:
     weightless = pr.parse_model({**model, "environment": {"gravity": [0.0, 0.0]}})
     at_rest = pr.efforts(pr.solve(weightless, q, zero, zero))
     _bound("regressor", kinds, actuated, _rel(tau0, at_rest), 1e-11)
+
+
+def test_a_legs_constraint_data_simplify_as_leg_as() -> None:
+    """direct_kinematics._simple simplifies leg B's and C's data as leg A's, renamed: the result
+    must be what trigsimp gives for the leg's own expression, and an expression of two legs
+    (no one-to-one renaming) must be simplified as it is."""
+
+    def leg(letter: str) -> sp.Expr:
+        q, a = sp.Symbol(f"qa_{letter}", real=True), sp.Symbol(f"alpha_{letter}", real=True)
+        x1 = sp.Symbol(f"x{letter}1", real=True)
+        return (
+            (x1 + sp.cos(a)) * sp.cos(q) - sp.sin(a) * sp.sin(q) + sp.sin(q) ** 2 + sp.cos(q) ** 2
+        )
+
+    for letter in "BC":
+        expr = leg(letter)
+        simple = direct_kinematics._simple(expr)
+        assert simple == sp.trigsimp(sp.expand(expr))
+        assert {s.name for s in simple.free_symbols} == {s.name for s in expr.free_symbols}
+    mixed = leg("A") + leg("B")
+    assert direct_kinematics._simple(mixed) == sp.trigsimp(sp.expand(mixed))
