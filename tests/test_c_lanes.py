@@ -66,10 +66,49 @@ def test_a_subtraction_keeps_its_order() -> None:
     assert "w_A" not in _groups(lines, 8)
 
 
-def test_lane_3_must_read_inside_the_parameters() -> None:
-    """params[0], [2], [4]: lane 3 would read params[6], past a vector of 6."""
-    assert "xA1" in _groups(legs(), 7)
-    assert "xA1" not in _groups(legs(), 6)
+def chain() -> list[Line]:
+    """``legs()`` and three statements of one leg each, read as lanes: four lane groups, enough
+    for :func:`lanes` to write its loops."""
+    lines = legs()
+    for name, before in (("a", "x@1"), ("b", "a_@"), ("c", "b_@")):
+        lines += [
+            assign(f"{name}_{leg}", f"2.0*{before.replace('@', leg)}", before.replace("@", leg))
+            for leg in "ABC"
+        ]
+    return [*lines, Line("store", "", frozenset({"c_B"}), ("out", "0", "c_B"))]
+
+
+def test_lane_3_never_reads_past_the_parameters() -> None:
+    """params[0], [2], [4]: lane 3 reads params[6] inside a vector of 7; in a vector of 6 the
+    loop reads the legs' copy, whose lane 3 is 0.0."""
+    inside = "\n".join(lanes(chain(), 7) or [])
+    assert "const double xi1 = params[0 + 2*i];" in inside
+    assert "params_by_leg" not in inside
+    past = "\n".join(lanes(chain(), 6) or [])
+    assert "const double xi1 = params_by_leg[0 + i];" in past
+    assert "params_by_leg[4*i + 0] = params[0 + i];" in past
+    assert "params_by_leg[4*i + 2] = params[4 + i];" in past
+    assert "params_by_leg[4*i + 3] = 0.0;" in past
+    assert "params[6" not in past
+
+
+def test_a_leg_block_of_a_large_stride_is_read_from_the_copy_by_leg() -> None:
+    """The general format's stride (17) is a group gcc does not vectorise: every leg parameter
+    at that stride is read from the copy, row k = params[k0 + k + 17*leg]; the copy's rows stay
+    inside the vector."""
+    lines = [
+        load("mA", 9), load("mB", 26), load("mC", 43),
+        load("JA", 16), load("JB", 33), load("JC", 50),
+        *(assign(f"u_{leg}", f"m{leg}*J{leg}", f"m{leg} J{leg}") for leg in "ABC"),
+        *(assign(f"v_{leg}", f"u_{leg}*u_{leg}", f"u_{leg}") for leg in "ABC"),
+        Line("store", "", frozenset({"v_C"}), ("out", "0", "v_C")),
+    ]  # fmt: skip
+    code = "\n".join(lanes(lines, 60) or [])
+    assert "const double mi = params_by_leg[0 + i];" in code
+    assert "const double Ji = params_by_leg[28 + i];" in code
+    assert "double params_by_leg[32];" in code  # rows 9..16: 8, a whole number of vectors
+    assert "params_by_leg[4*i + 2] = params[43 + i];" in code
+    assert "for (i = 0; i < 8; ++i) {" in code
 
 
 def test_a_statement_reading_two_legs_stays_scalar() -> None:

@@ -19,17 +19,25 @@ taking every statement whose operands an earlier phase computed, in the schedule
 (:mod:`.order`). A lane value read after its loop is kept in an array of 4 and read back just
 before its first reader as the leg's scalar (``const double rx_B = rx_legs[1];``).
 
-Lane 3 loads ``params[k0 + 3 d]`` (checked to lie inside the parameter vector): an unrelated
-parameter, so its values mean nothing and are never read. Its arithmetic can raise
-floating-point exception flags the three legs would not raise; the library is built with
-``-fno-trapping-math`` and does not support running with floating-point traps enabled.
+Lane 3 loads ``params[k0 + 3 d]``: an unrelated parameter, so its values mean nothing and are
+never read. That holds for strides ``d`` of 1 and 2 inside the vector (the paper's formats). A
+leg's parameters at a larger stride (the general format: 17 per leg) are one interleaved group
+of 17 loads to gcc's loop vectoriser, which it does not vectorise: the general structures' lane
+loops ran as scalar loops of four turns (the general 3-RPR's inverse dynamics: 206 ns in the
+single call, against ~100 for the paper's variant of the same robot). So the kernel first copies
+those parameters leg by leg, :data:`BY_LEG`: ``by_leg[4 k + leg]`` is leg ``leg``'s parameter
+``k`` of its block (lane 3 holds 0.0, and never reads past the vector), a copy that gcc
+vectorises as a 4x4 transposition, and the lanes load ``by_leg[4 k + i]``, contiguous (134 ns).
+Lane 3's arithmetic can raise floating-point exception flags the three legs would not raise;
+the library is built with ``-fno-trapping-math`` and does not support running with
+floating-point traps enabled.
 """
 
 from __future__ import annotations
 
 import ast
 import re
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 
 from rpr3gen_derive.codegen.backends.c.order import Line
@@ -42,6 +50,10 @@ WIDTH = 4
 LOOP = f"for (i = 0; i < {WIDTH}; ++i) {{ /* legs A, B, C; lane 3 unused */"
 #: Fewest lane groups that make a function's loops worth their overhead.
 MIN_GROUPS = 4
+#: The legs' parameters copied leg by leg, for strides the vectoriser does not take (the module).
+BY_LEG = "params_by_leg"
+#: The largest stride of a leg's parameters that the lanes read from ``params`` itself.
+MAX_STRIDE = 2
 
 _INDEX = re.compile(r"params\[(\d+)\]$")
 _NAME = re.compile(r"\b[A-Za-z_]\w*\b")
@@ -88,6 +100,7 @@ def _groups(lines: Sequence[Line], param_count: int) -> dict[str, tuple[int, int
     by_name = {x.name: x for x in lines if x.name}
     member: dict[str, tuple[int, int]] = {}
     count = 0
+    families: list[tuple[list[str], int, int]] = []
     for line in lines:  # a leg's parameters: an arithmetic progression inside params
         family = leg_family(line.name, by_name.keys()) if line.kind == "load" else None
         if family is None:
@@ -95,10 +108,13 @@ def _groups(lines: Sequence[Line], param_count: int) -> dict[str, tuple[int, int
         head, tail = family
         loads = [head + leg + tail for leg in LEGS]
         index = [_INDEX.match(by_name[n].payload[0]) for n in loads]
-        if not all(index):
-            continue
-        k0, k1, k2 = (int(m.group(1)) for m in index if m)
-        if k1 - k0 == k2 - k1 != 0 and 0 <= k0 + 3 * (k1 - k0) < param_count:
+        if all(index):
+            k0, k1, k2 = (int(m.group(1)) for m in index if m)
+            if k2 - k1 == k1 - k0 != 0 and k0 + 3 * (k1 - k0) >= 0:
+                families.append((loads, k0, k1 - k0))
+    copied = _copied_stride([(k0, d) for _, k0, d in families], param_count)
+    for loads, k0, d in families:  # read from params, or from the copy by leg (the module)
+        if d == copied or (abs(d) <= MAX_STRIDE and k0 + 3 * d < param_count):
             for leg, n in enumerate(loads):
                 member[n] = (count, leg)
             count += 1
@@ -134,7 +150,8 @@ def lanes(lines: Sequence[Line], param_count: int, indent: str = "    ") -> list
             found.setdefault(member[line.name][0], []).append(line)
     if len(found) < MIN_GROUPS:
         return None
-    groups = _named(found, member, {x.name for x in lines if x.name} | {"i"})
+    groups = _named(found, member, {x.name for x in lines if x.name} | {"i", BY_LEG})
+    by_leg = _by_leg(groups.values(), param_count)
     # units in the scheduler's order: a group stands where its first member stood
     units: list[Line | _Group] = []
     placed: set[int] = set()
@@ -158,6 +175,19 @@ def lanes(lines: Sequence[Line], param_count: int, indent: str = "    ") -> list
         f"{indent}double {groups[g].name}_legs[{WIDTH}];"
         for g in sorted(kept, key=lambda g: groups[g].name)
     ]
+    if by_leg is not None:
+        start, d, rows = by_leg
+        out += [
+            f"{indent}double {BY_LEG}[{WIDTH * rows}]; /* params[{start} + {d}*leg + k] at "
+            f"[{WIDTH}*k + leg]; lane 3: 0.0 */",
+            f"{indent}for (i = 0; i < {rows}; ++i) {{",
+            *(
+                f"{indent}    {BY_LEG}[{WIDTH}*i + {leg}] = params[{start + d * leg} + i];"
+                for leg in range(len(LEGS))
+            ),
+            f"{indent}    {BY_LEG}[{WIDTH}*i + {len(LEGS)}] = 0.0;",
+            f"{indent}}}",
+        ]
     unpacked: set[str] = set()
     for p in range(max(phase) + 1):
         here = [unit for u, unit in enumerate(units) if phase[u] == p]
@@ -175,7 +205,7 @@ def lanes(lines: Sequence[Line], param_count: int, indent: str = "    ") -> list
         out.append(indent + LOOP)
         for unit in here:
             assert isinstance(unit, _Group)
-            text = _lane_text(unit, member, groups, where, p)
+            text = _lane_text(unit, member, groups, where, p, by_leg)
             out.append(f"{indent}    const double {unit.name} = {text};")
             if member[unit.members[0].name][0] in kept:
                 out.append(f"{indent}    {unit.name}_legs[i] = {unit.name};")
@@ -198,6 +228,41 @@ def _named(
         taken.add(name)
         groups[g] = _Group((a, b, c), name)
     return groups
+
+
+def _progression(group: _Group) -> tuple[int, int] | None:
+    """``(k0, d)`` when ``group`` is a leg parameter's loads ``params[k0 + d*leg]``."""
+    a, b, _ = group.members
+    first, second = _INDEX.match(a.payload[0]), _INDEX.match(b.payload[0])
+    if a.kind != "load" or not first or not second:
+        return None
+    k0 = int(first.group(1))
+    return k0, int(second.group(1)) - k0
+
+
+def _needs_copy(k0: int, d: int, param_count: int) -> bool:
+    return d > MAX_STRIDE or k0 + 3 * d >= param_count
+
+
+def _copied_stride(families: Sequence[tuple[int, int]], param_count: int) -> int | None:
+    """The stride of the leg parameters read from :data:`BY_LEG` (the most common of those
+    that need it; the others stay scalar), or None."""
+    strides = [d for k0, d in families if d > 0 and _needs_copy(k0, d, param_count)]
+    return max(sorted(set(strides)), key=strides.count) if strides else None
+
+
+def _by_leg(groups: Iterable[_Group], param_count: int) -> tuple[int, int, int] | None:
+    """``(start, d, rows)`` of :data:`BY_LEG`: rows ``k`` hold the legs'
+    ``params[start + d*leg + k]``, a whole number of vectors where the vector allows it;
+    None when every lane reads ``params`` itself."""
+    found = list(filter(None, map(_progression, groups)))
+    d = _copied_stride(found, param_count)
+    if d is None:
+        return None
+    start = min(k0 for k0, stride in found if stride == d)
+    rows = max(k0 for k0, stride in found if stride == d) + 1 - start
+    whole = -(-rows // WIDTH) * WIDTH
+    return start, d, whole if start + 2 * d + whole <= param_count else rows
 
 
 def _lines_of(unit: Line | _Group) -> tuple[Line, ...]:
@@ -234,14 +299,18 @@ def _lane_text(
     groups: dict[int, _Group],
     where: dict[str, int],
     p: int,
+    by_leg: tuple[int, int, int] | None,
 ) -> str:
-    """Leg A's statement for lane ``i``: a parameter as ``params[k0 + d*i]``, a group's value
-    as the loop's local (same loop) or its array's lane (an earlier loop)."""
-    a, b, _ = group.members
-    first, second = _INDEX.match(a.payload[0]), _INDEX.match(b.payload[0])
-    if a.kind == "load" and first and second:
-        k0 = int(first.group(1))
-        return f"params[{k0} + {int(second.group(1)) - k0}*i]"
+    """Leg A's statement for lane ``i``: a parameter as ``params[k0 + d*i]`` (or its row of
+    :data:`BY_LEG`), a group's value as the loop's local (same loop) or its array's lane (an
+    earlier loop)."""
+    a = group.members[0]
+    progression = _progression(group)
+    if progression is not None:
+        k0, d = progression
+        if by_leg is not None and d == by_leg[1]:
+            return f"{BY_LEG}[{WIDTH * (k0 - by_leg[0])} + i]"
+        return f"params[{k0} + {d}*i]"
 
     def local(m: re.Match[str]) -> str:
         n = m.group(0)
