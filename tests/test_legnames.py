@@ -47,11 +47,14 @@ def test_program_symbols_are_never_renamed() -> None:
 
 
 def test_a_parameter_name_is_never_taken() -> None:
-    """The general PRR model has parameters ``x1_A``...: a temporary ``x1`` keeps its name even
-    where this function does not read them (the C backend finds parameters by name)."""
+    """The general PRR model has parameters ``x1_A``...: a temporary ``x1`` never takes one of
+    their names, even where this function does not read them (the C backend finds parameters by
+    name); the legs' names then join the letter with two underscores, or three."""
     lines = [(x1, xA1 * c), (x5, xB1 * c), (x9, xC1 * c)]
     outputs = [("out[0]", x1 + x5 + x9)]
     renamed, _ = leg_names(lines, outputs, {x1, x5, x9}, frozenset({"x1_B"}))
-    assert [str(s) for s, _ in renamed] == ["x1", "x5", "x9"]
+    assert [str(s) for s, _ in renamed] == ["x1__A", "x1__B", "x1__C"]
+    renamed, _ = leg_names(lines, outputs, {x1, x5, x9}, frozenset({"x1_B", "x1__C"}))
+    assert [str(s) for s, _ in renamed] == ["x1___A", "x1___B", "x1___C"]
     renamed, _ = leg_names(lines, outputs, {x1, x5, x9})
     assert [str(s) for s, _ in renamed] == ["x1_A", "x1_B", "x1_C"]

@@ -5,7 +5,8 @@
 print as ``(a + x38) + b*x6`` and ``(a + b*x20) + x50``. Those round differently, so the C
 backend cannot run them as lanes of one vector (:mod:`.backends.c.lanes`). :func:`leg_names`
 renames three temporaries that are one expression for the three legs to ``x38_A``, ``x38_B``,
-``x38_C`` (leg A's number). Then every name of leg B compares to the expression's other names as
+``x38_C`` (leg A's number; ``x1__A`` ... where ``x1_A`` is taken, as by the general format's
+parameters). Then every name of leg B compares to the expression's other names as
 leg A's does, and the legs print their sums in one order.
 
 A leg's symbols are the program's: names that differ only by the leg's letter at one place
@@ -98,11 +99,14 @@ def leg_names(
             if len(three) != len(LEGS) or any(t in rename for t in three.values()):
                 continue
             base = str(three[0])
-            targets = [f"{base}_{leg}" for leg in LEGS]
-            if any(t in names for t in targets):
+            for glue in ("_", "__", "___"):  # x1_A may be a parameter's (the general format's)
+                targets = [f"{base}{glue}{leg}" for leg in LEGS]
+                if not any(t in names for t in targets):
+                    break
+            else:
                 continue
             for leg, sym in three.items():
-                leg_of[sym] = (f"{base}_@", leg)
+                leg_of[sym] = (f"{base}{glue}@", leg)
                 rename[sym] = sp.Symbol(targets[leg], real=True)
                 names.add(targets[leg])
                 grouped.append(sym)

@@ -27,7 +27,7 @@ loops ran as scalar loops of four turns (the general 3-RPR's inverse dynamics: 2
 single call, against ~100 for the paper's variant of the same robot). So the kernel first copies
 those parameters leg by leg, :data:`BY_LEG`: ``by_leg[4 k + leg]`` is leg ``leg``'s parameter
 ``k`` of its block (lane 3 holds 0.0, and never reads past the vector), a copy that gcc
-vectorises as a 4x4 transposition, and the lanes load ``by_leg[4 k + i]``, contiguous (134 ns).
+vectorises as a 4x4 transposition, and the lanes load ``by_leg[4 k + i]``, contiguous (133 ns).
 Lane 3's arithmetic can raise floating-point exception flags the three legs would not raise;
 the library is built with ``-fno-trapping-math`` and does not support running with
 floating-point traps enabled.
