@@ -55,9 +55,10 @@ def header(r: dict[str, Any]) -> str:
 
 
 def c_figures(r: dict[str, Any], key: str) -> dict[str, dict[str, float]]:
-    """``{function: {"floor", "single", "batch": ns, "agree": 0|1, "failed": n}}``: the best of
-    the repeats (the least disturbed by other processes: the machine is shared); ``failed``:
-    the samples on which a single call failed."""
+    """``{function: {"floor", "single", "batch", "chain": ns, "agree": 0|1, "failed": n}}``: the
+    best of the repeats (the least disturbed by other processes: the machine is shared);
+    ``chain``: the chain floor (runs before 2026-11-27 and the iterative forward kinematics have
+    none); ``failed``: the samples on which a single call failed."""
     found: dict[str, dict[str, float]] = {}
     for name, value in r["c"][key]["results"].items():
         function, what = name.split("/")
@@ -105,7 +106,7 @@ def targets(r: dict[str, Any]) -> str:
         for f, goal in (("inverse_dynamics", 2.0), ("forward_dynamics", 2.0)):
             x = c[f]["single"] / c[f]["floor"]
             rows.append([f"C single / floor, `{f}` ({v})",
-                         f"{ns(c[f]['single'])} / {ns(c[f]['floor'])} = {x:.2f}x",
+                         f"{ns(c[f]['single'])} / {ns(c[f]['floor'])} = {x:.2f}x{chained(c[f])}",
                          f"≤ {goal}x", verdict(x, goal, True)])  # fmt: skip
         x = c["inverse_dynamics"]["batch"] / c["inverse_dynamics"]["floor"]
         rows.append([f"C batch / floor, `inverse_dynamics` ({v})", f"{x:.2f}x", "≤ 1.2x",
@@ -144,12 +145,23 @@ def targets(r: dict[str, Any]) -> str:
     return table(["target", "measured", "goal", "result"], rows)
 
 
+def over_chain(x: dict[str, float]) -> str:
+    """``68 ns = 1.45x``: the chain floor and the single call's ratio to it, if measured."""
+    return f"{ns(x['chain'])} = {x['single'] / x['chain']:.2f}x" if "chain" in x else ""
+
+
+def chained(x: dict[str, float]) -> str:
+    """`` (chain floor 68 ns = 1.45x)`` after a target's figure, if measured."""
+    return f" (chain floor {over_chain(x)})" if "chain" in x else ""
+
+
 def functions(r: dict[str, Any], v: str) -> str:
     rows = []
     c = c_figures(r, f"{v}/generic")
     for f, x in c.items():
         numpy = py(r, f"functions/{v}/{f}")
         cells = [f"`{f}`", ns(x["floor"])]
+        cells.append(over_chain(x))
         cells += [f"{ns(x[k])} = {x[k] / x['floor']:.2f}x" for k in ("single", "batch")]
         cells.append(f"{ns(numpy * 1e4)} = {numpy * 1e4 / x['floor']:.2f}x" if numpy else "")
         cells.append(agreed(x))
@@ -157,10 +169,11 @@ def functions(r: dict[str, Any], v: str) -> str:
     if f"{v}/rotation" in r["c"]:
         rot = c_figures(r, f"{v}/rotation")["inverse_dynamics"]
         rows.append(["`inverse_dynamics`, rotation motion", ns(rot["floor"]),
+                     over_chain(rot),
                      *(f"{ns(rot[k])} = {rot[k] / rot['floor']:.2f}x" for k in ("single", "batch")),
                      "", agreed(rot)])  # fmt: skip
     flags = r["c"][f"{v}/generic"]["flags"]
-    head = ["function", "floor", "C single", "C batch", "NumPy", "single = batch"]
+    head = ["function", "floor", "chain floor", "C single", "C batch", "NumPy", "single = batch"]
     return f"**{v}** (`cc {flags}`; ns per sample, best of the repeats):\n\n" + table(head, rows)
 
 
@@ -254,7 +267,11 @@ def calls(r: dict[str, Any]) -> str:
 
 FLOOR = (
     "*Floor*: the libm calls the function's generated kernel makes (sin, cos, sqrt, atan2), in a "
-    "loop, nothing else. *C single*: the function once per sample, back to back; *C batch*: over "
+    "loop, nothing else (the ratios of the C and NumPy columns are to it). *Chain floor*: the "
+    "kernel's longest chain of dependent operations, each at its latency measured in the same "
+    "run (`benchmarks/c/latency.c`), and the single call's ratio to it: what one call takes "
+    "when it waits for nothing but itself (back-to-back calls can overlap and go below it). "
+    "*C single*: the function once per sample, back to back; *C batch*: over "
     "chunks of 1,000 samples, outputs in cache; *NumPy*: `evaluate` at 10^5 samples (allocation "
     "and checks included), ns per sample.\n"
 )

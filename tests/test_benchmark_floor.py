@@ -1,5 +1,6 @@
-"""The C benchmark's floor (``benchmarks/harness/cbench.py``): the libm calls a generated kernel
-makes per sample. Nothing is timed or built here."""
+"""The C benchmark's floors (``benchmarks/harness/cbench.py``, ``benchmarks/harness/chain.py``):
+the libm calls a generated kernel makes per sample, and its longest chain of dependent
+operations. Nothing is timed or built here."""
 
 from __future__ import annotations
 
@@ -56,3 +57,93 @@ def test_the_inverse_dynamics_floor_has_each_legs_calls(
     assert calls["sin"] == calls["cos"] == 1
     assert calls["sqrt"] == 4
     assert calls["atan2"] == 3
+
+
+# The chain floor (benchmarks/harness/chain.py): a kernel's longest chain of dependent
+# operations, on latencies given here (the benchmark measures them; nothing is timed here).
+
+UNIT = dict.fromkeys(("add", "mul", "div", "sqrt", "sin", "cos", "atan2", "fmin", "rint"), 0.0)
+
+
+@pytest.fixture(scope="module")
+def chain(repo_root: Path) -> ModuleType:
+    sys.path.insert(0, str(repo_root / "benchmarks"))
+    try:
+        from harness import chain as module
+    finally:
+        sys.path.remove(str(repo_root / "benchmarks"))
+    return module
+
+
+def latencies(**given: float) -> dict[str, float]:
+    return {**UNIT, **given}
+
+
+CHAIN = """
+static int p_g_kernel(const double *restrict params, const double *restrict q)
+{
+    int i;
+    double L_i_legs[4];
+    const double c = p_cos(q[2]);
+    const double third = (1.0/3.0)*params[0];
+    for (i = 0; i < 4; ++i) { /* legs A, B, C; lane 3 unused */
+        const double rx_i = c*params[1 + 2*i] - q[0];
+        const double L_i = sqrt(rx_i*rx_i + third);
+        L_i_legs[i] = L_i;
+    }
+    const double L_A = L_i_legs[0];
+    const double L_B = L_i_legs[1];
+    const double side = params[7] + params[8];
+    r_out[0] = 1.0/(L_A + L_B) - side;
+    if (!(r_out[0] >= 0.0)) { /* also catches NaN */
+        return P_SINGULAR;
+    }
+    return P_OK;
+}
+"""
+
+
+def test_the_chain_is_the_longest_path_of_latencies(chain: ModuleType) -> None:
+    """cos -> mul -> add (rx) -> mul -> add -> sqrt (L) -> add -> div -> add; the leg loop once,
+    the constant 1/3 folded, ``side`` off the path."""
+    body = chain.kernel_bodies(CHAIN, "p")["g"]
+    lat = latencies(add=1.0, mul=10.0, div=100.0, sqrt=1000.0, cos=10000.0)
+    assert chain.critical_path(body, lat, "p") == 10000 + 10 + 1 + 10 + 1 + 1000 + 1 + 100 + 1
+
+
+@pytest.mark.parametrize("op", ["add", "mul", "div", "sqrt", "cos"])
+def test_each_latency_counts_as_often_as_the_path_takes_it(chain: ModuleType, op: str) -> None:
+    body = chain.kernel_bodies(CHAIN, "p")["g"]
+    times = {"add": 4, "mul": 2, "div": 1, "sqrt": 1, "cos": 1}[op]
+    assert chain.critical_path(body, latencies(**{op: 1.0}), "p") == times
+
+
+@pytest.mark.parametrize(
+    "line",
+    [
+        "    const double t = a > b ? a : b;",  # a branch
+        "    for (k = 0; k < 3; ++k) {",  # a loop that is not over the legs
+        "    const double t = p_forward_kinematics_kernel(params, q);",  # another kernel
+        "    const double t = pow(a, 3);",  # a power gcc does not make a product
+        "    t += 1.0;",  # not an assignment of a value
+    ],
+)
+def test_code_that_is_not_straight_line_has_no_chain(chain: ModuleType, line: str) -> None:
+    body = CHAIN.replace("    return P_OK;", line + "\n    return P_OK;")
+    assert chain.critical_path(chain.kernel_bodies(body, "p")["g"], latencies(add=1.0), "p") is None
+
+
+@pytest.mark.parametrize("variant", ["revolute", "prismatic"])
+def test_the_forward_dynamics_chain_runs_through_its_long_operations(
+    chain: ModuleType, repo_root: Path, variant: str
+) -> None:
+    """On its longest paths: the platform's angle (one sin or cos), then a leg's length and the
+    conditioning guard's root (two sqrt), or the leg's 1/L and the LDL^T solve's three pivots
+    (four divisions); the forward kinematics, a loop, has no chain."""
+    source = (repo_root / "generated" / variant / "rpr3.c").read_text()
+    bodies = chain.kernel_bodies(source, "rpr3")
+    fd = bodies["forward_dynamics"]
+    assert chain.critical_path(fd, latencies(sin=1.0, cos=1.0)) == 1
+    assert chain.critical_path(fd, latencies(sqrt=1.0)) == 2
+    assert chain.critical_path(fd, latencies(div=1.0)) == 4
+    assert chain.critical_path(bodies["forward_kinematics"], latencies(add=1.0)) is None

@@ -10,6 +10,10 @@ subexpression elimination and nothing else: its ``sin``, ``cos``, ``sqrt``, ``at
 kernels' ``rpr3_sin`` etc. count as the libm call they replace), on arguments formed from the
 sample's first input: a sin and a cos of one argument (gcc merges them into ``sincos``), the
 sqrt of a sum of squares, the atan2 of two components.
+
+The chain floor of a function (:mod:`harness.chain`) is its kernel's longest chain of dependent
+operations, each weighted by its latency as ``benchmarks/c/latency.c`` measures it right after
+the functions, in the same build: what one call takes when it waits for nothing but itself.
 """
 
 from __future__ import annotations
@@ -26,7 +30,7 @@ from typing import Any
 from rpr3gen_derive.codegen.backends.c.lanes import LOOP
 from rpr3gen_derive.codegen.legnames import LEGS
 
-from harness import samples
+from harness import chain, samples
 from rpr3gen import cbackend
 from rpr3gen.manifest import FunctionInfo
 
@@ -44,8 +48,7 @@ def kernel_calls(source: str, prefix: str) -> dict[str, dict[str, int]]:
     per sample: a call inside a loop over the legs (``derive/codegen/backends/c/lanes.py``)
     counts once per leg."""
     calls = {}
-    for match in re.finditer(rf"^static int {prefix}_(\w+)_kernel\(", source, re.M):
-        body = source[match.start() : source.index("\n}\n", match.start())]
+    for name, body in chain.kernel_bodies(source, prefix).items():
         found = dict.fromkeys(LIBM, 0)
         legs, close = 1, None  # inside a lane loop: its calls run once per leg
         for line in body.splitlines():
@@ -55,7 +58,7 @@ def kernel_calls(source: str, prefix: str) -> dict[str, dict[str, int]]:
                 legs, close = 1, None
             for f in LIBM:
                 found[f] += legs * len(re.findall(rf"(?:\b|\b{prefix}_){f}(?:_fast)?\(", line))
-        calls[match.group(1)] = {f: k for f, k in found.items() if k}
+        calls[name] = {f: k for f, k in found.items() if k}
     return calls
 
 
@@ -147,10 +150,23 @@ def parse(stdout: str) -> dict[str, dict[str, Any]]:
     return {line.pop("name"): line for line in lines}
 
 
+def chains(source: str, prefix: str, latency: dict[str, float]) -> dict[str, dict[str, float]]:
+    """Each straight-line kernel's chain floor (:mod:`harness.chain`), ns, as result lines
+    ``NAME/chain``."""
+    found = {}
+    for name, body in chain.kernel_bodies(source, prefix).items():
+        length = chain.critical_path(body, latency, prefix)
+        if length is not None:
+            found[f"{name}/chain"] = {"min": length}
+    return found
+
+
 def run(variant: str, motion: str, n: int, repeats: int) -> dict[str, Any]:
-    """Time every measurable function of ``variant`` on ``n`` samples of ``motion``."""
+    """Time every measurable function of ``variant`` on ``n`` samples of ``motion``, and the
+    latencies of its chains' operations (``c/latency.c``) right after, in the same build."""
     found = samples.code(variant)
     arrays = samples.motion(variant, motion, n)
+    source = found.path("c_source")
     with tempfile.TemporaryDirectory(prefix="rpr3bench-") as tmp:
         build = Path(tmp)
         text, names = header(variant)
@@ -162,14 +178,21 @@ def run(variant: str, motion: str, n: int, repeats: int) -> dict[str, Any]:
         model = samples.model(variant)
         params = build / "params.txt"
         params.write_text("".join(f"{k} {v!r}\n" for k, v in model.params.items()))
-        exe = build / "functions"
+        exe, probe = build / "functions", build / "latency"
+        include = ["-I", str(build), "-I", str(C_DIR), "-I", str(found.folder)]
         subprocess.run(
-            [*CC, *FLAGS, "-I", str(build), "-I", str(C_DIR), "-I", str(found.folder),
-             str(C_DIR / "functions.c"), str(found.path("c_source")), "-lm", "-o", str(exe)],
+            [*CC, *FLAGS, *include, str(C_DIR / "functions.c"), str(source), "-lm", "-o", str(exe)],
             check=True,
         )  # fmt: skip
+        subprocess.run([*CC, *FLAGS, *include, str(C_DIR / "latency.c"), "-lm", "-o", str(probe)],
+                       check=True)  # fmt: skip
         done = subprocess.run(
             [str(exe), str(params), str(build), str(n), str(repeats)],
             capture_output=True, text=True, check=True,
         )  # fmt: skip
-    return {"flags": " ".join(FLAGS), "samples": n, "results": parse(done.stdout)}
+        timed = subprocess.run([str(probe), "2000000", str(repeats)], capture_output=True,
+                               text=True, check=True)  # fmt: skip
+    results = parse(done.stdout)
+    latency = {name.split("/", 1)[1]: x["min"] for name, x in parse(timed.stdout).items()}
+    results.update(chains(source.read_text(), found.prefix, latency))
+    return {"flags": " ".join(FLAGS), "samples": n, "results": results, "latency": latency}
