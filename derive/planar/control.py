@@ -180,7 +180,7 @@ def _own_joint_powers(prog: Program, derivation: Derivation) -> dict[str, list[s
 
 def _virtual_powers(
     prog: Program, structure: Structure
-) -> list[tuple[tuple[sp.Expr, ...], sp.Expr]]:
+) -> list[tuple[str | None, tuple[sp.Expr, ...], sp.Expr]]:
     """``J^T tau = sum_m row_m * w_m``: the virtual power of the required wrenches per unit twist.
 
     Give the platform a virtual twist ``e_k`` (principle of virtual work, as for eqs. 12-17).
@@ -190,28 +190,73 @@ def _virtual_powers(
     F_y, M_z)`` of its own. The actuators supply ``tau . J e_k``, so the sum is ``(J^T tau)_k``
     whatever joints are actuated (the passive ones do no work). The joint rates are kept in
     factored form (seed vector times scalar), so each term is a row vector times one named
-    scalar ``w_m``.
+    scalar ``w_m``; each term comes with its leg (``None``: the platform's).
     """
     derivation = include_inverse_dynamics(prog, structure)
     bld = builder(prog, structure)
     rates = [derivation.kinematics[leg].qd[j] for leg in LEGS for j in range(3)]
     rows = differentiate_factored(prog, rates, list(syms.qd), STEP_JACOBIAN)
     powers = _own_joint_powers(prog, derivation)
-    terms: list[tuple[tuple[sp.Expr, ...], sp.Expr]] = []
+    terms: list[tuple[str | None, tuple[sp.Expr, ...], sp.Expr]] = []
     for i, leg in enumerate(LEGS):
         for j in range(3):
             if powers[leg][j] == 0:
                 continue
             for k, (coeff, seed) in enumerate(rows[3 * i + j]):
                 w = bld.define(f"w{j + 1}_{leg}_{k}", coeff * powers[leg][j], STEP_TASK)
-                terms.append((seed, w))
+                terms.append((leg, seed, w))
     cos_phi, sin_phi = (sp.Symbol(n, real=True) for n in ("cos_phi", "sin_phi"))
     robot = derivation.robot
     platform = platform_wrench(robot, platform_inertia(robot, cos_phi, sin_phi))
     for k, value in enumerate((*platform.force, platform.moment)):
         unit = tuple(sp.Integer(int(j == k)) for j in range(3))
-        terms.append((unit, bld.define(f"w3_{k + 1}", value, STEP_TASK)))
+        terms.append((None, unit, bld.define(f"w3_{k + 1}", value, STEP_TASK)))
     return terms
+
+
+#: A share of the task-space dynamics: of ``M`` (3 x 3, its upper triangle) and of ``c`` (3).
+Share = tuple[sp.Matrix, sp.Matrix]
+
+
+def _shares(prog: Program, structure: Structure) -> dict[str | None, Share]:
+    """Each leg's share of ``M`` and ``c``, and the platform's (key ``None``): the virtual
+    powers of :func:`_virtual_powers` differentiated by ``q''`` and at ``q'' = 0``, summed leg by
+    leg. A leg's entries are named ``M11_A`` ... ``bias1_A`` ...: one expression for the three
+    legs, which the C backend runs side by side (its lanes), so that ``M`` and ``c`` are sums of
+    four terms each instead of one long scalar sum over every joint of every leg."""
+    terms = _virtual_powers(prog, structure)
+    powers = [w for _, _, w in terms]
+    slopes = differentiate_factored(prog, powers, list(syms.qdd), STEP_TANGENT)
+    at_rest = at_zero(prog, powers, list(syms.qdd), "_qdd0", STEP_BIAS)
+    sums: dict[str | None, Share] = {}
+    for (leg, row, _), slope, w0 in zip(terms, slopes, at_rest, strict=True):
+        mass, bias = sums.setdefault(leg, (sp.zeros(3, 3), sp.zeros(3, 1)))
+        column = expand_factored(slope, 3)
+        for i, j in UPPER:
+            mass[i, j] += row[i] * column[j]
+        for i in range(3):
+            bias[i] += row[i] * w0
+    for mass, _ in sums.values():
+        if any(depends_on(prog, entry, list(syms.qdd)) for entry in mass):
+            raise RuntimeError("the generalized forces are not affine in q''")
+    bld = Builder(prog)
+
+    def named(leg: str, mass: sp.Matrix, bias: sp.Matrix) -> Share:
+        return (
+            sp.Matrix(3, 3, lambda i, j: bld.define(f"M{i + 1}{j + 1}_{leg}", mass[i, j], STEP_TASK)
+                      if i <= j else 0),
+            sp.Matrix([bld.define(f"bias{k + 1}_{leg}", bias[k], STEP_TASK) for k in range(3)]),
+        )  # fmt: skip
+
+    return {leg: share if leg is None else named(leg, *share) for leg, share in sums.items()}
+
+
+def _total(shares: dict[str | None, Share]) -> Share:
+    """``M`` (upper triangle) and ``c``: the sums of the shares."""
+    return (
+        sum((mass for mass, _ in shares.values()), sp.zeros(3, 3)),
+        sum((bias for _, bias in shares.values()), sp.zeros(3, 1)),
+    )
 
 
 def task_space_dynamics(
@@ -229,8 +274,8 @@ def task_space_dynamics(
     - ``method="virtual_power"`` (the default, about half the operations): ``J^T tau`` is the
       virtual power of the same required wrenches in the unit platform twists
       (:func:`_virtual_powers`), so no closure matrix is inverted; then the same
-      differentiation and zeroing. ``M`` and ``c`` are those of the mechanism, the same for
-      every choice of actuated joint.
+      differentiation and zeroing, leg by leg (:func:`_shares`). ``M`` and ``c`` are those of
+      the mechanism, the same for every choice of actuated joint.
 
     Only the upper triangle of ``M`` is named (``M11 M12 M13 M22 M23 M33``); ``c`` is named
     ``bias1..3``.
@@ -241,21 +286,7 @@ def task_space_dynamics(
         mass = J.T * A
         bias = J.T * b
     elif method == "virtual_power":
-        terms = _virtual_powers(prog, structure)
-        powers = [w for _, w in terms]
-        slopes = differentiate_factored(prog, powers, list(syms.qdd), STEP_TANGENT)
-        mass = sp.zeros(3, 3)
-        for (row, _), slope in zip(terms, slopes, strict=True):
-            column = expand_factored(slope, 3)
-            for i, j in UPPER:
-                mass[i, j] += row[i] * column[j]
-        for entry in mass:
-            if depends_on(prog, entry, list(syms.qdd)):
-                raise RuntimeError("the generalized forces are not affine in q''")
-        at_rest = at_zero(prog, powers, list(syms.qdd), "_qdd0", STEP_BIAS)
-        bias = sp.zeros(3, 1)
-        for (row, _), w0 in zip(terms, at_rest, strict=True):
-            bias += sp.Matrix(row) * w0
+        mass, bias = _total(_shares(prog, structure))
     else:
         raise ValueError(f"method must be 'virtual_power' or 'efforts', got {method!r}")
     M = _symmetric(prog, "M", {(i, j): mass[i, j] for i, j in UPPER})
@@ -267,14 +298,23 @@ def task_space_dynamics(
 def forward_dynamics(prog: Program, structure: Structure) -> sp.Matrix:
     """``q'' = M^-1 (J^T tau - c)`` (3-vector), for the efforts :data:`~.symbols.tau`, by LDL^T.
 
-    ``M``, ``c`` of :func:`task_space_dynamics` (default route) and the 3 x 3 solve of
-    :func:`~.calculus.ldlt_solve`. Nothing here divides by ``det J``: the forward dynamics is
-    defined at a parallel singularity too (the efforts just cannot push the platform along the
-    singular direction); only a serial singularity is. Units: m/s^2, m/s^2, rad/s^2.
+    ``M`` and ``c`` of :func:`task_space_dynamics` (default route: the legs' shares, and the
+    right-hand side ``J^T tau - c`` summed from each leg's ``J_i^T tau_i - c_i`` too) and the
+    3 x 3 solve of :func:`~.calculus.ldlt_solve`. Nothing here divides by ``det J``: the forward
+    dynamics is defined at a parallel singularity too (the efforts just cannot push the platform
+    along the singular direction); only a serial singularity is. Units: m/s^2, m/s^2, rad/s^2.
     """
-    M, c = task_space_dynamics(prog, structure)
+    shares = _shares(prog, structure)
+    mass, _ = _total(shares)
+    M = _symmetric(prog, "M", {(i, j): mass[i, j] for i, j in UPPER})
     J = actuator_jacobian(prog, structure)
-    rhs = J.T * syms.tau - c
     bld = Builder(prog)
+    rhs = -shares[None][1]
+    for i, leg in enumerate(LEGS):  # J^T tau - c leg by leg (leg i drives actuator i), as lanes
+        bias = shares[leg][1]
+        rhs += sp.Matrix([
+            bld.define(f"fd_rhs{k + 1}_{leg}", J[i, k] * syms.tau[i] - bias[k], STEP_FORWARD)
+            for k in range(3)
+        ])  # fmt: skip
     rhs = sp.Matrix([bld.define(f"fd_rhs{k + 1}", rhs[k], STEP_FORWARD) for k in range(3)])
     return ldlt_solve(prog, M, rhs, "fd", STEP_FORWARD)
