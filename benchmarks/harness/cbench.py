@@ -150,12 +150,15 @@ def parse(stdout: str) -> dict[str, dict[str, Any]]:
     return {line.pop("name"): line for line in lines}
 
 
-def chains(source: str, prefix: str, latency: dict[str, float]) -> dict[str, dict[str, float]]:
-    """Each straight-line kernel's chain floor (:mod:`harness.chain`), ns, as result lines
-    ``NAME/chain``."""
+def chains(
+    source: str, prefix: str, latency: dict[str, float], names: list[str]
+) -> dict[str, dict[str, float]]:
+    """The chain floor (:mod:`harness.chain`) of each function of ``names`` whose kernel is
+    straight-line code, ns, as result lines ``NAME/chain``."""
     found = {}
-    for name, body in chain.kernel_bodies(source, prefix).items():
-        length = chain.critical_path(body, latency, prefix)
+    bodies = chain.kernel_bodies(source, prefix)
+    for name in names:
+        length = chain.critical_path(bodies[name], latency, prefix)
         if length is not None:
             found[f"{name}/chain"] = {"min": length}
     return found
@@ -194,5 +197,5 @@ def run(variant: str, motion: str, n: int, repeats: int) -> dict[str, Any]:
                                text=True, check=True)  # fmt: skip
     results = parse(done.stdout)
     latency = {name.split("/", 1)[1]: x["min"] for name, x in parse(timed.stdout).items()}
-    results.update(chains(source.read_text(), found.prefix, latency))
+    results.update(chains(source.read_text(), found.prefix, latency, names))
     return {"flags": " ".join(FLAGS), "samples": n, "results": results, "latency": latency}
