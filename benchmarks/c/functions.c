@@ -10,6 +10,12 @@
  * of function NAME, raw float64. Prints JSON lines (timing.h): NAME/floor, NAME/single,
  * NAME/batch in ns per sample, and NAME/agree (1 when single calls and the batch give the same
  * bits on the first CHUNK samples, NaN payloads aside) with the failed counts.
+ *
+ * The repeats run in rounds: each round times every function in turn (an untimed pass first,
+ * which brings its inputs back into cache, then its floor, single and batch loops one after the
+ * other), and each figure is the best of its rounds. So a function's repeats spread over the
+ * whole program's run, not a fraction of a second of it: on a shared machine whose other tenants
+ * slow it for seconds at a time, one slow spell no longer spoils every repeat of a function.
  */
 #include "timing.h"
 
@@ -64,71 +70,96 @@ static void read_params(const char *path, double *params)
     fclose(f);
 }
 
-static void measure(const struct function *f, const double *params, const char *dir, size_t n,
-                    size_t repeats)
-{
+/* One function's inputs, outputs and timings across the rounds. */
+struct bench {
+    const struct function *f;
     const double *in[MAX_ARGS];
-    double *out[MAX_ARGS], *rows[MAX_ARGS], *floor_ns, *single_ns, *batch_ns;
-    char path[4096], label[128];
-    double sink = 0.0;
-    size_t r, k, failed_single = 0, failed_batch = 0;
-    int j, agree = 1;
+    double *out[MAX_ARGS], *rows[MAX_ARGS];
+    double *floor_ns, *single_ns, *batch_ns;
+    size_t failed_single, failed_batch;
+    double sink;
+};
+
+/* Reads a function's inputs, allocates its outputs and runs each loop once untimed. */
+static void prepare(struct bench *b, const struct function *f, const double *params,
+                    const char *dir, size_t n, size_t repeats)
+{
+    char path[4096];
+    int j;
+    b->f = f;
     for (j = 0; j < f->n_in; ++j) {
         snprintf(path, sizeof path, "%s/%s-%d.bin", dir, f->name, j);
-        in[j] = read_doubles(path, n * (size_t)f->in_size[j]);
+        b->in[j] = read_doubles(path, n * (size_t)f->in_size[j]);
     }
     for (j = 0; j < f->n_out; ++j) {
-        out[j] = malloc(CHUNK * (size_t)f->out_size[j] * sizeof(double));
-        rows[j] = malloc(CHUNK * (size_t)f->out_size[j] * sizeof(double));
+        b->out[j] = malloc(CHUNK * (size_t)f->out_size[j] * sizeof(double));
+        b->rows[j] = malloc(CHUNK * (size_t)f->out_size[j] * sizeof(double));
     }
-    floor_ns = malloc(3 * repeats * sizeof(double));
-    single_ns = floor_ns + repeats;
-    batch_ns = single_ns + repeats;
-    sink += f->floor(in, n); /* warm-up */
-    failed_single = f->single(params, in, n, out, 0);
-    failed_batch = f->batch(params, in, n, out);
-    for (r = 0; r < repeats; ++r) { /* the three loops interleaved: shared conditions */
-        double t0 = timing_now_ns();
-        sink += f->floor(in, n);
-        floor_ns[r] = (timing_now_ns() - t0) / (double)n;
-        t0 = timing_now_ns();
-        f->single(params, in, n, out, 0);
-        single_ns[r] = (timing_now_ns() - t0) / (double)n;
-        t0 = timing_now_ns();
-        f->batch(params, in, n, out);
-        batch_ns[r] = (timing_now_ns() - t0) / (double)n;
-    }
-    f->single(params, in, CHUNK, rows, 1); /* single calls and the batch, bit for bit */
-    f->batch(params, in, CHUNK, out);
+    b->floor_ns = malloc(3 * repeats * sizeof(double));
+    b->single_ns = b->floor_ns + repeats;
+    b->batch_ns = b->single_ns + repeats;
+    b->sink = f->floor(b->in, n);
+    b->failed_single = f->single(params, b->in, n, b->out, 0);
+    b->failed_batch = f->batch(params, b->in, n, b->out);
+}
+
+/* Round r of a function: one untimed pass (its inputs back in cache after the other functions'
+ * rounds), then its floor, single and batch loops timed one after the other. */
+static void time_round(struct bench *b, const double *params, size_t n, size_t r)
+{
+    const struct function *f = b->f;
+    double t0;
+    f->single(params, b->in, n, b->out, 0);
+    t0 = timing_now_ns();
+    b->sink += f->floor(b->in, n);
+    b->floor_ns[r] = (timing_now_ns() - t0) / (double)n;
+    t0 = timing_now_ns();
+    f->single(params, b->in, n, b->out, 0);
+    b->single_ns[r] = (timing_now_ns() - t0) / (double)n;
+    t0 = timing_now_ns();
+    f->batch(params, b->in, n, b->out);
+    b->batch_ns[r] = (timing_now_ns() - t0) / (double)n;
+}
+
+/* Checks single calls against the batch bit for bit, prints the function's lines, frees it. */
+static void finish(struct bench *b, const double *params, size_t repeats)
+{
+    const struct function *f = b->f;
+    char label[128];
+    size_t k;
+    int j, agree = 1;
+    f->single(params, b->in, CHUNK, b->rows, 1); /* single calls and the batch, bit for bit */
+    f->batch(params, b->in, CHUNK, b->out);
     for (j = 0; j < f->n_out; ++j) { /* the same bits, or both NaN (of any payload) */
         for (k = 0; k < CHUNK * (size_t)f->out_size[j]; ++k) {
-            const double a = out[j][k], b = rows[j][k];
-            agree = agree && ((a != a && b != b) || memcmp(&a, &b, sizeof a) == 0);
+            const double a = b->out[j][k], c = b->rows[j][k];
+            agree = agree && ((a != a && c != c) || memcmp(&a, &c, sizeof a) == 0);
         }
     }
     snprintf(label, sizeof label, "%s/floor", f->name);
-    timing_summary(label, "ns", floor_ns, repeats);
+    timing_summary(label, "ns", b->floor_ns, repeats);
     snprintf(label, sizeof label, "%s/single", f->name);
-    timing_summary(label, "ns", single_ns, repeats);
+    timing_summary(label, "ns", b->single_ns, repeats);
     snprintf(label, sizeof label, "%s/batch", f->name);
-    timing_summary(label, "ns", batch_ns, repeats);
+    timing_summary(label, "ns", b->batch_ns, repeats);
     printf("{\"name\": \"%s/agree\", \"agree\": %d, \"failed_single\": %zu, \"failed_batch\": "
            "%zu, \"sink\": %g}\n",
-           f->name, agree, failed_single, failed_batch, sink);
+           f->name, agree, b->failed_single, b->failed_batch, b->sink);
     for (j = 0; j < f->n_in; ++j) {
-        free((void *)in[j]);
+        free((void *)b->in[j]);
     }
     for (j = 0; j < f->n_out; ++j) {
-        free(out[j]);
-        free(rows[j]);
+        free(b->out[j]);
+        free(b->rows[j]);
     }
-    free(floor_ns);
+    free(b->floor_ns);
 }
 
 int main(int argc, char **argv)
 {
     double params[RPR3_NUM_PARAMS];
-    size_t k, n, repeats;
+    struct bench benches[sizeof FUNCTIONS / sizeof FUNCTIONS[0]];
+    size_t k, r, n, repeats, count = 0;
     if (argc < 5) {
         fprintf(stderr, "usage: functions PARAMS DIR N REPEATS [NAME...]\n");
         return 2;
@@ -142,8 +173,16 @@ int main(int argc, char **argv)
             wanted = wanted || strcmp(argv[a], FUNCTIONS[k].name) == 0;
         }
         if (wanted) {
-            measure(&FUNCTIONS[k], params, argv[2], n, repeats);
+            prepare(&benches[count++], &FUNCTIONS[k], params, argv[2], n, repeats);
         }
+    }
+    for (r = 0; r < repeats; ++r) { /* the functions in turn, each round: see the top */
+        for (k = 0; k < count; ++k) {
+            time_round(&benches[k], params, n, r);
+        }
+    }
+    for (k = 0; k < count; ++k) {
+        finish(&benches[k], params, repeats);
     }
     return 0;
 }
