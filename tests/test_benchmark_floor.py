@@ -4,6 +4,7 @@ operations. Nothing is timed or built here."""
 
 from __future__ import annotations
 
+import importlib
 import sys
 from pathlib import Path
 from types import ModuleType
@@ -11,14 +12,18 @@ from types import ModuleType
 import pytest
 
 
-@pytest.fixture(scope="module")
-def cbench(repo_root: Path) -> ModuleType:
+def harness(repo_root: Path, name: str) -> ModuleType:
+    """``benchmarks/harness/NAME.py``, imported as the benchmarks import it."""
     sys.path.insert(0, str(repo_root / "benchmarks"))
     try:
-        from harness import cbench as module
+        return importlib.import_module(f"harness.{name}")
     finally:
         sys.path.remove(str(repo_root / "benchmarks"))
-    return module
+
+
+@pytest.fixture(scope="module")
+def cbench(repo_root: Path) -> ModuleType:
+    return harness(repo_root, "cbench")
 
 
 SOURCE = """
@@ -67,12 +72,7 @@ UNIT = dict.fromkeys(("add", "mul", "div", "sqrt", "sin", "cos", "atan2", "fmin"
 
 @pytest.fixture(scope="module")
 def chain(repo_root: Path) -> ModuleType:
-    sys.path.insert(0, str(repo_root / "benchmarks"))
-    try:
-        from harness import chain as module
-    finally:
-        sys.path.remove(str(repo_root / "benchmarks"))
-    return module
+    return harness(repo_root, "chain")
 
 
 def latencies(**given: float) -> dict[str, float]:
