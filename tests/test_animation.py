@@ -73,7 +73,7 @@ def test_refuses_absurd_requests_up_front(request_: dict, words: str) -> None:
 
 
 def test_mp4_needs_ffmpeg(monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.setattr(animation.frames, "_ffmpeg_available", lambda: False)
+    monkeypatch.setattr(animation.frames, "ffmpeg_path", lambda: None)
     with pytest.raises(InputError, match="ffmpeg"):
         animation.plan(np.linspace(0.0, 1.0, 3), "robot.mp4")
 
@@ -182,7 +182,6 @@ def test_cli_writes_the_movie(tmp_path: Path, capsys: pytest.CaptureFixture[str]
         assert (gif.n_frames, gif.size) == (4, (320, 240))
 
 
-@pytest.mark.skipif(not animation.frames._ffmpeg_available(), reason="ffmpeg is not installed")
 def test_mp4_through_ffmpeg(tmp_path: Path) -> None:
     model, traj = _robot("rrr")
     out = tmp_path / "rrr.mp4"
@@ -190,3 +189,18 @@ def test_mp4_through_ffmpeg(tmp_path: Path) -> None:
     assert plan.frames == 7
     assert out.read_bytes()[4:8] == b"ftyp"  # an MP4 container
     assert [p.name for p in tmp_path.iterdir()] == ["rrr.mp4"]
+
+
+def test_mp4_without_a_system_ffmpeg_uses_the_video_extras(tmp_path: Path) -> None:
+    """With matplotlib's ffmpeg missing, imageio-ffmpeg's build writes the movie, and the
+    user's ``rcParams`` stay as they were."""
+    import imageio_ffmpeg
+    import matplotlib as mpl
+
+    model, traj = _robot("rrr")
+    out = tmp_path / "rrr.mp4"
+    with mpl.rc_context({"animation.ffmpeg_path": str(tmp_path / "no-such-ffmpeg")}):
+        assert animation.frames.ffmpeg_path() == imageio_ffmpeg.get_ffmpeg_exe()
+        animation.write_animation(model, traj, out, fps=FPS, size=(320, 240))
+        assert mpl.rcParams["animation.ffmpeg_path"] == str(tmp_path / "no-such-ffmpeg")
+    assert out.read_bytes()[4:8] == b"ftyp"

@@ -116,10 +116,10 @@ def plan(
             f"{path}: the movie's suffix must be {' or '.join(FORMATS)}, got {suffix or 'none'!r}"
         )
     writer = FORMATS[suffix]
-    if writer == "ffmpeg" and not _ffmpeg_available():
+    if writer == "ffmpeg" and ffmpeg_path() is None:
         raise InputError(
-            f"{path}: MP4 needs ffmpeg, which is not installed (e.g. apt-get install ffmpeg); "
-            "or write a .gif"
+            f"{path}: MP4 needs ffmpeg, which is not installed (pip install 'rpr3gen[video]', "
+            "or apt-get install ffmpeg); or write a .gif"
         )
     if isinstance(fps, bool) or not (isinstance(fps, int) and 1 <= fps <= MAX_FPS):
         raise InputError(f"fps: must be an integer from 1 to {MAX_FPS} frames/s, got {fps!r}")
@@ -156,7 +156,20 @@ def plan(
     return Plan(path, writer, fps, float(speed), (width, height), samples)
 
 
-def _ffmpeg_available() -> bool:
+def ffmpeg_path() -> str | None:
+    """The ffmpeg that writes MP4: matplotlib's (its ``animation.ffmpeg_path``, by default the
+    ``ffmpeg`` on the PATH) when that runs, else the build that the ``video`` extra installs
+    (imageio-ffmpeg's), else ``None``."""
+    import matplotlib as mpl
     from matplotlib import animation as mpl_animation
 
-    return bool(mpl_animation.writers.is_available("ffmpeg"))
+    if mpl_animation.writers.is_available("ffmpeg"):
+        return str(mpl.rcParams["animation.ffmpeg_path"])
+    try:
+        import imageio_ffmpeg
+    except ImportError:
+        return None
+    try:
+        return str(imageio_ffmpeg.get_ffmpeg_exe())
+    except RuntimeError:  # a platform it has no build for
+        return None

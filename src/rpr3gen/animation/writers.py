@@ -1,14 +1,15 @@
-"""The movie writers: Pillow's GIF writer with one palette for the whole file, or ffmpeg's MP4."""
+"""The movie writers: Pillow's GIF writer with one palette for the whole file, or ffmpeg's MP4
+(the system's ffmpeg, or imageio-ffmpeg's build: :func:`~.frames.ffmpeg_path`)."""
 
 from __future__ import annotations
 
 from functools import cache
 from typing import TYPE_CHECKING, Any
 
-from rpr3gen.animation.frames import Plan
+from rpr3gen.animation.frames import Plan, ffmpeg_path
 
 if TYPE_CHECKING:  # matplotlib and Pillow are imported when a movie is made, not with the CLI
-    from matplotlib.animation import AbstractMovieWriter
+    from matplotlib.animation import AbstractMovieWriter, FFMpegWriter
 
 PALETTE_COLOURS = 128
 """Colours of the GIF's one palette (the drawing uses a few dozen, plus antialiasing)."""
@@ -52,6 +53,19 @@ def _gif_writer() -> type[AbstractMovieWriter]:
 def writer(plan_: Plan) -> AbstractMovieWriter:
     if plan_.writer == "pillow":
         return _gif_writer()(fps=plan_.fps)
+    return _ffmpeg_writer(ffmpeg_path())(
+        fps=plan_.fps, codec="libx264", extra_args=["-pix_fmt", "yuv420p"]
+    )
+
+
+def _ffmpeg_writer(path: str | None) -> type[FFMpegWriter]:
+    """matplotlib's ffmpeg writer running ``path`` (:func:`~.frames.ffmpeg_path`), which may be
+    imageio-ffmpeg's build, without changing the user's ``rcParams``."""
     from matplotlib.animation import FFMpegWriter
 
-    return FFMpegWriter(fps=plan_.fps, codec="libx264", extra_args=["-pix_fmt", "yuv420p"])
+    class Writer(FFMpegWriter):  # type: ignore[misc]
+        @classmethod
+        def bin_path(cls) -> str:
+            return path or str(super().bin_path())
+
+    return Writer

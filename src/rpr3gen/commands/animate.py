@@ -21,7 +21,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         help="draw the robot moving along a trajectory, with its actuator efforts (GIF or MP4)",
         description="Draw the base, the legs and the platform along the motion, the actuator "
         "efforts as bars and as curves with a time cursor (and with --loads every joint's "
-        "force as an arrow); GIF through Pillow, MP4 through ffmpeg when installed. Frames are "
+        "force as an arrow); GIF through Pillow, MP4 through ffmpeg (the system's, or the "
+        "video extra's: pip install 'rpr3gen[video]'). Frames are "
         f"bounded: at most {animation.MAX_FRAMES}, sides {animation.MIN_SIDE} to "
         f"{animation.MAX_SIDE} pixels.",
     )
