@@ -163,7 +163,7 @@ def measure(results: dict[str, Any], structures: Sequence[str], quick: bool) -> 
         results["c"][f"{variant}/generic"] = cbench.run(variant, "generic", n, repeats)
     if paper:
         log("control-loop examples")
-        results["examples"] = examples.run()
+        results["examples"] = examples.run(2 if quick else examples.RUNS)
     results["python"] = {}
     for group in PYPERF if paper else ("structures",):
         log(f"pyperf: {group}")

@@ -1,6 +1,7 @@
-"""The C benchmark's floors (``benchmarks/harness/cbench.py``, ``benchmarks/harness/chain.py``):
-the libm calls a generated kernel makes per sample, and its longest chain of dependent
-operations. Nothing is timed or built here."""
+"""The benchmark harness's pure parts (``benchmarks/harness/``): the libm calls a generated
+kernel makes per sample (``cbench.py``), its longest chain of dependent operations
+(``chain.py``), and the control-loop examples' reports (``examples.py``). Nothing is timed or
+built here."""
 
 from __future__ import annotations
 
@@ -147,3 +148,41 @@ def test_the_forward_dynamics_chain_runs_through_its_long_operations(
     assert chain.critical_path(fd, latencies(sqrt=1.0)) == 2
     assert chain.critical_path(fd, latencies(div=1.0)) == 4
     assert chain.critical_path(bodies["forward_kinematics"], latencies(add=1.0)) is None
+
+
+# The control-loop examples (benchmarks/harness/examples.py): the programs' latency lines
+# parsed, and the best of several runs kept with every run's tick p50.
+
+REPORT = """\
+failed calls: forward kinematics 0, jacobian 0, dynamics 0
+latency forward kinematics: p50 {fk} ns, p99 521 ns, max 6362 ns
+latency rest of the tick: p50 210 ns, p99 431 ns, max 4062455 ns
+latency whole tick: p50 {tick} ns, p99 982 ns, max 4.06 ms
+"""
+
+
+@pytest.fixture(scope="module")
+def examples(repo_root: Path) -> ModuleType:
+    return harness(repo_root, "examples")
+
+
+def test_latency_lines_are_parsed_in_their_units(examples: ModuleType) -> None:
+    found = examples.parse(REPORT.format(fk=260, tick=461).replace("4.06 ms", "4062705 ns"))
+    assert found["forward kinematics"] == {"p50": 260.0, "p99": 521.0, "max": 6362.0}
+    assert found["whole tick"]["max"] == 4062705.0
+    micro = examples.parse("latency whole tick: p50 9.57 us, p99 32.46 us, max 120.5 us\n")
+    assert micro["whole tick"] == {"p50": 9570.0, "p99": 32460.0, "max": 120500.0}
+    # a line in mixed units is not a latency line
+    assert examples.parse(REPORT.format(fk=260, tick=461)).keys() == {
+        "forward kinematics",
+        "rest of the tick",
+    }
+
+
+def test_the_run_with_the_lowest_tick_p50_is_kept_with_every_run(examples: ModuleType) -> None:
+    runs = [examples.parse(REPORT.format(fk=fk, tick=tick).replace("4.06 ms", "5000 ns"))
+            for fk, tick in [(321, 601), (251, 461), (300, 531)]]  # fmt: skip
+    best = examples.best_run(runs)
+    assert best["whole tick"]["p50"] == 461.0
+    assert best["forward kinematics"]["p50"] == 251.0  # that run's, not the lowest of each
+    assert best["runs"] == [601.0, 461.0, 531.0]
