@@ -110,8 +110,10 @@ def regenerate_hint(folder: Path) -> str:
     return f"regenerate it: rpr3gen generate --out {folder}"
 
 
+@cache
 def default_folder() -> Path:
-    """Folder of the installed generated package ``rpr3gen_generated``."""
+    """Folder of the installed generated package ``rpr3gen_generated`` (looked up once: every
+    array call asks for it, and ``importlib.resources`` takes ~30 µs to answer)."""
     return Path(str(resources.files("rpr3gen_generated")))
 
 
