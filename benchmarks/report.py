@@ -275,7 +275,16 @@ def calls(r: dict[str, Any]) -> str:
             floor = f"{nan * 1e6:.3f}" if nan else ""
             rows.append([parts[1], f"`{parts[2]}`", f"{call * 1e6:.3f}", floor,
                          f"{(call - (nan or 0)) * 1e6:.3f}"])  # fmt: skip
-    return table(["variant", "function", "call (µs)", "NaN input: the ctypes floor", "the C"], rows)
+    arrays = [f"`rpr3gen.{name.split('/')[2]}` ({name.split('/')[1]}) "
+              f"{py(r, name) * 1e6:.0f} µs"  # type: ignore[operator]
+              for name in sorted(r["python"]) if name.startswith("array/")]  # fmt: skip
+    text = table(["variant", "function", "call (µs)", "NaN input: the ctypes floor", "the C"], rows)
+    if arrays:
+        text += (
+            '\nThe array API on one sample, `backend="c"` (its checks, the parameter '
+            "vector and the named outputs around the same C): " + ", ".join(arrays) + ".\n"
+        )
+    return text
 
 
 FLOOR = (

@@ -136,6 +136,15 @@ def call_benchmarks(variant: str) -> dict[str, Callable[[int], float]]:
                 return ev
 
             found[f"calls/{variant}/{name}{'/nan' if nan else ''}"] = timed(setup)
+    for name in ("inverse_dynamics", "forward_dynamics"):  # the array API on one sample
+
+        def array_setup(name: str = name) -> Callable[[], object]:
+            last = (1.0, -2.0, 0.5) if name == "forward_dynamics" else pose["qdd"][1500]
+            args = (pose["q"][1500], pose["qd"][1500], last)
+            call = getattr(rpr3gen, name)
+            return lambda: call(model, *args, backend="c")
+
+        found[f"array/{variant}/{name}"] = timed(array_setup)
     return found
 
 
