@@ -13,5 +13,6 @@ _expand_small_powers = create_expand_pow_optimization(3)
 
 
 def prepare(expr: sp.Expr) -> sp.Expr:
-    """Rewrite ``x**2``, ``x**3`` as products so that printers emit no ``pow`` for them."""
+    """Rewrite ``x**2``, ``x**3`` of a symbol ``x`` as products so that printers emit no
+    ``pow`` for them (a compound base keeps its power: :mod:`.c.printer`)."""
     return optimize(expr, [_expand_small_powers])

@@ -1,7 +1,9 @@
 """The C99 printer: SymPy's, lightly subclassed.
 
-Squares and small integer powers are expanded to products by SymPy's rewriting passes before
-printing (:func:`rpr3gen_derive.codegen.backends.prepare`), so no ``pow`` is emitted for them.
+Squares and cubes of a symbol are expanded to products by SymPy's rewriting passes before
+printing (:func:`rpr3gen_derive.codegen.backends.prepare`). A compound base keeps its power:
+``pow(a + b, 2)``, which compilers make the product ``(a + b)*(a + b)`` from -O1 on (gcc 12;
+the same value: both are the exactly rounded square); at -O0 it is a call of libm's ``pow``.
 ``sin``, ``cos``, ``atan2``, ``Min``, ``Max`` and the rounding of ``wrap_angle`` are printed as
 calls of the generated C's own inline kernels (:mod:`rpr3gen_derive.codegen.mathkernels`),
 ``{prefix}_sin`` etc., so that loops over samples vectorise. In the batch loops
