@@ -316,8 +316,9 @@ def paper_parts(r: dict[str, Any]) -> list[str]:
         "runs several times and the run with the lowest tick p50 is shown (its FK, rest and "
         "p99 are that run's), with every run's tick p50 after it (`harness/examples.py`: the "
         "same binary's p50 moves by up to half between runs on this shared machine); the "
-        "Python program runs once. The tick's p50 includes one of its three clock readings "
-        "(~30 ns, `clock_gettime` on this machine).\n\n",
+        "Python program runs once. The ticks alternate: an even one is split at the end of its "
+        "forward kinematics (FK and rest), an odd one is timed whole, with no clock reading "
+        "inside it (one costs ~30 ns, `clock_gettime` on this machine).\n\n",
         control_loop(r),
         "\n## Python calls (`SampleEvaluator`, the C through ctypes)\n", calls(r),
         "\n## Peers\n",

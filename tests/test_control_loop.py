@@ -187,3 +187,26 @@ def test_c_control_loop_start_offset(repo_root: Path, c_build: Path) -> None:
     readme = (repo_root / "examples" / "control_loop" / "README.md").read_text(encoding="utf-8")
     assert "starts 1 mm off in x" in readme
     assert f"largest position error, {numbers['overall pos_max']:.4f} mm" in readme
+
+
+def test_the_ticks_alternate_between_the_split_and_the_whole_measure(
+    repo_root: Path, c_build: Path
+) -> None:
+    """The first tick is split at the end of its forward kinematics (a clock read inside it), the
+    second is timed whole (no clock read inside): one tick gives the two parts and no whole tick,
+    two ticks give each measure once (p50 = p99 = max, a single value)."""
+    for run in (
+        lambda *a: _run_c(c_build, "prismatic", *a),
+        lambda *a: _run_python(repo_root, "prismatic", *a, cwd=c_build),
+    ):
+        one = run("rotation", "--seconds", "0.001")
+        assert "latency whole tick: no tick measured" in one, one
+        for label in ("forward kinematics", "rest of the tick"):
+            assert re.search(rf"latency {label}: p50 [\d.]+ (ns|us), p99", one), one
+        two = run("rotation", "--seconds", "0.002")
+        for label in ("forward kinematics", "rest of the tick", "whole tick"):
+            m = re.search(
+                rf"latency {label}: p50 ([\d.]+) (ns|us), p99 ([\d.]+) \2, max ([\d.]+)", two
+            )
+            assert m, two
+            assert m.group(1) == m.group(3) == m.group(4), two

@@ -12,8 +12,11 @@
  *   tau   : J^T tau = M (qdd_d + Kd (qd_d - q') + Kp (q_d - q)) + c
  * Prints the tracking error, the pose and velocity estimates' errors, the failed calls and the
  * latency (p50, p99, max) of the forward kinematics, of the rest of the tick (velocity, reference,
- * dynamics, law) and of the whole tick. The variant (actuation) is the generated folder the
- * program is built with. The arguments are control_loop.py's (but --model and --actuation):
+ * dynamics, law) and of the whole tick. The ticks alternate between the two measures: an even
+ * tick is split at the end of its forward kinematics (a clock read between the parts), an odd
+ * tick is timed whole, with no clock read inside it (a read costs ~30 ns, which the whole tick
+ * would otherwise carry). The variant (actuation) is the generated folder the program is built
+ * with. The arguments are control_loop.py's (but --model and --actuation):
  *
  *   make && ./control_loop_revolute [--params FILE] [--trajectory rectilinear|rotation]
  *                                   [--seconds T] [--offset MM] [rectilinear|rotation]
@@ -203,14 +206,28 @@ struct controller {
     long failed_fk, failed_jacobian, failed_dynamics;
 };
 
-/* One tick: encoder counts at time t in, ctl->tau out; ns[0..3) the latencies of its forward
- * kinematics, of the rest and of the whole tick (three clock readings, one inside the tick). */
-static void controller_tick(struct controller *ctl, const long *counts, double t, double *ns)
+/* The end of a tick begun at start: its latencies (controller_tick). */
+static void finish(double start, double fk_end, int split, double *ns)
+{
+    const double end = now_ns();
+    if (split) {
+        ns[0] = fk_end - start;
+        ns[1] = end - fk_end;
+    } else {
+        ns[2] = end - start;
+    }
+}
+
+/* One tick: encoder counts at time t in, ctl->tau out. With split, ns[0] and ns[1] receive the
+ * latencies of its forward kinematics and of the rest (three clock reads, one between them);
+ * else ns[2] that of the whole tick (two clock reads, none inside it). */
+static void controller_tick(struct controller *ctl, const long *counts, double t, int split,
+                            double *ns)
 {
     const double dt = 1.0 / RATE_HZ;
     const double start = now_ns();
     double qa[3], near[3], q[3], J[9], M[9], c[3], f[3], q_d[3], qd_d[3], qdd_d[3], acc[3];
-    double fk_end;
+    double fk_end = 0.0;
     const int first = !ctl->started;
     int status, i, k;
 
@@ -227,8 +244,9 @@ static void controller_tick(struct controller *ctl, const long *counts, double t
 
     /* the pose: tracked forward kinematics from the prediction */
     status = rpr3_forward_kinematics(ctl->params, qa, near, q);
-    fk_end = now_ns();
-    ns[0] = fk_end - start;
+    if (split) {
+        fk_end = now_ns();
+    }
     if (status != RPR3_OK) {
         ++ctl->failed_fk;
         memcpy(q, near, sizeof q); /* coast on the prediction */
@@ -239,8 +257,7 @@ static void controller_tick(struct controller *ctl, const long *counts, double t
     if (rpr3_actuator_jacobian(ctl->params, q, J) != RPR3_OK
         || solve3(J, ctl->rate, 0, ctl->qd) != 0) { /* the velocity: J q' = qa' */
         ++ctl->failed_jacobian;
-        ns[2] = now_ns() - start;
-        ns[1] = ns[2] - ns[0];
+        finish(start, fk_end, split, ns);
         return; /* hold the last efforts */
     }
 
@@ -262,8 +279,7 @@ static void controller_tick(struct controller *ctl, const long *counts, double t
     if (status != RPR3_OK) {
         ++ctl->failed_dynamics;
     }
-    ns[2] = now_ns() - start;
-    ns[1] = ns[2] - (fk_end - start);
+    finish(start, fk_end, split, ns);
 }
 
 /* control_loop.py's arguments: --params FILE, --trajectory NAME (or NAME alone), --seconds T,
@@ -320,6 +336,10 @@ static int compare(const void *a, const void *b)
 
 static void print_latency(const char *label, double *ns, long n)
 {
+    if (n == 0) {
+        printf("latency %s: no tick measured\n", label);
+        return;
+    }
     qsort(ns, (size_t)n, sizeof *ns, compare);
     printf("latency %s: p50 %.0f ns, p99 %.0f ns, max %.0f ns\n", label, ns[n / 2],
            ns[(long)(0.99 * (n - 1))], ns[n - 1]);
@@ -356,7 +376,7 @@ int main(int argc, char **argv)
     double q[3], qd[3] = {0.0, 0.0, 0.0}, velocity_sq[2] = {0.0, 0.0};
     double tau_sq = 0.0, dtau_sq = 0.0, dtau_max = 0.0, previous_tau[3] = {0.0, 0.0, 0.0};
     double *latency;
-    long step, counts[3];
+    long step, counts[3], n_split = 0, n_whole = 0;
     int k;
 
     if (parse_arguments(argc, argv, &params_file, &name, &seconds, &offset) != 0
@@ -387,7 +407,8 @@ int main(int argc, char **argv)
     ctl.resolution = revolute ? 2.0 * PI / COUNTS_PER_REV : METRES_PER_COUNT;
     ctl.alpha = 1.0 - exp(-2.0 * PI * RATE_CUTOFF_HZ / RATE_HZ);
     q[0] = 1e-3 * offset, q[1] = 0.0 - 1e-3 * offset, q[2] = 0.0; /* the controller assumes home */
-    latency = malloc(3 * (size_t)steps * sizeof *latency); /* fk, dynamics, tick */
+    /* fk and rest of the split ticks, whole of the others: at most steps values each */
+    latency = malloc(3 * (size_t)steps * sizeof *latency);
     if (latency == NULL) {
         fprintf(stderr, "control_loop: out of memory\n");
         return 1;
@@ -395,16 +416,21 @@ int main(int argc, char **argv)
 
     for (step = 0; step < steps; ++step) {
         const double t = step * dt;
-        double ns[3], q_d[3], qd_d[3], qdd_d[3], dq[3];
+        double ns[3] = {0.0, 0.0, 0.0}, q_d[3], qd_d[3], qdd_d[3], dq[3];
         if (encoders(truth, q, ctl.resolution, counts) != 0) {
             fprintf(stderr, "control_loop: the plant reached a singular pose at t = %g s\n", t);
             free(latency);
             return 1;
         }
-        controller_tick(&ctl, counts, t, ns);
-        latency[step] = ns[0];
-        latency[steps + step] = ns[1];
-        latency[2 * steps + step] = ns[2];
+        controller_tick(&ctl, counts, t, step % 2 == 0, ns);
+        if (step % 2 == 0) { /* a split tick */
+            latency[n_split] = ns[0];
+            latency[steps + n_split] = ns[1];
+            ++n_split;
+        } else {
+            latency[2 * steps + n_whole] = ns[2];
+            ++n_whole;
+        }
 
         for (k = 0; k < 3; ++k) {
             dq[k] = ctl.qd[k] - qd[k];
@@ -461,9 +487,9 @@ int main(int argc, char **argv)
            unit, dtau_max, unit);
     printf("failed calls: forward kinematics %ld, jacobian %ld, dynamics %ld\n", ctl.failed_fk,
            ctl.failed_jacobian, ctl.failed_dynamics);
-    print_latency("forward kinematics", latency, steps);
-    print_latency("rest of the tick", latency + steps, steps);
-    print_latency("whole tick", latency + 2 * steps, steps);
+    print_latency("forward kinematics", latency, n_split);
+    print_latency("rest of the tick", latency + steps, n_split);
+    print_latency("whole tick", latency + 2 * steps, n_whole);
     free(latency);
     return ctl.failed_fk || ctl.failed_jacobian || ctl.failed_dynamics ? 1 : 0;
 }

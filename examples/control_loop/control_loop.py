@@ -9,7 +9,9 @@ model's task-space dynamics. Every generated function is called through
 rpr3gen.SampleEvaluator (the generated C, preallocated buffers); the tick's own arithmetic is on
 Python floats (a NumPy operation on a 3-vector costs more than the C it feeds). Prints the
 tracking error, the failed calls and the latency (p50, p99, max) of the forward kinematics, of
-the rest of the tick and of the whole controller tick.
+the rest of the tick and of the whole controller tick. As in control_loop.c, the ticks alternate
+between the two measures: an even tick is split at the end of its forward kinematics, an odd
+tick is timed whole, with no clock read inside it.
 
 The arguments are control_loop.c's, plus --model and --actuation (the C program's are its build):
 
@@ -115,10 +117,13 @@ class Controller:
         self.qd = [0.0, 0.0, 0.0]
         self.tau = [0.0, 0.0, 0.0]
         self.failed = {"forward kinematics": 0, "jacobian": 0, "dynamics": 0}
-        self.latency = [0, 0, 0]  # ns: forward kinematics, the rest, the whole tick
+        # ns: forward kinematics, the rest (a split tick), the whole tick (another); NaN unmeasured
+        self.latency = [math.nan, math.nan, math.nan]
 
-    def tick(self, counts: tuple[int, int, int], t: float) -> list[float]:
-        """Encoder counts at time t in, efforts out; latencies in :attr:`latency`."""
+    def tick(self, counts: tuple[int, int, int], t: float, split: bool = False) -> list[float]:
+        """Encoder counts at time t in, efforts out; latencies in :attr:`latency`: with
+        ``split``, of the forward kinematics and of the rest (a clock read between them), else
+        of the whole tick (no clock read inside it)."""
         clock = time.perf_counter_ns
         start = clock()
         res = self.resolution
@@ -136,7 +141,7 @@ class Controller:
         near = (2.0 * q1[0] - q2[0], 2.0 * q1[1] - q2[1], 2.0 * q1[2] - q2[2])
         fk.q_near[:] = near
         status = fk()
-        fk_end = clock()
+        fk_end = clock() if split else 0
         if status:
             self.failed["forward kinematics"] += 1
             fk.q[:] = near  # coast on the prediction
@@ -160,13 +165,19 @@ class Controller:
             else:
                 self.tau = eff.tau.tolist()
         end = clock()
-        self.latency = [fk_end - start, end - fk_end, end - start]
+        if split:
+            self.latency = [fk_end - start, end - fk_end, math.nan]
+        else:
+            self.latency = [math.nan, math.nan, end - start]
         return self.tau
 
 
 def percentiles(ns: np.ndarray) -> tuple[float, float, float]:
-    """p50, p99 and max, as control_loop.c picks them (ranks n/2 and 0.99 (n - 1) of the sorted)."""
-    s = np.sort(ns)
+    """p50, p99 and max of the measured (not NaN) values, as control_loop.c picks them (ranks
+    n/2 and 0.99 (n - 1) of the sorted); NaN when there is none."""
+    s = np.sort(ns[~np.isnan(ns)])
+    if len(s) == 0:
+        return math.nan, math.nan, math.nan
     return float(s[len(s) // 2]), float(s[int(0.99 * (len(s) - 1))]), float(s[-1])
 
 
@@ -215,7 +226,7 @@ def main() -> int:
     for step in range(steps):
         t = step * dt
         counts = plant.encoders()
-        tau = controller.tick(counts, t)
+        tau = controller.tick(counts, t, split=step % 2 == 0)
         latency[step] = controller.latency
         d = np.array(controller.q1) - plant.q
         estimate[step] = math.hypot(d[0], d[1]), abs(d[2])
@@ -258,6 +269,9 @@ def main() -> int:
     print("failed calls: " + ", ".join(f"{k} {v}" for k, v in controller.failed.items()))
     for k, label in enumerate(("forward kinematics", "rest of the tick", "whole tick")):
         p50, p99, worst = percentiles(latency[:, k])
+        if math.isnan(p50):
+            print(f"latency {label}: no tick measured")
+            continue
         print(
             f"latency {label}: p50 {p50 / 1e3:.2f} us, p99 {p99 / 1e3:.2f} us, "
             f"max {worst / 1e3:.2f} us"
