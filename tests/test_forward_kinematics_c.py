@@ -92,8 +92,9 @@ def _build(folder: Path, actuation: str, **context: object) -> ctypes.CDLL:
         return dataclasses.replace(spec, c_context=tuple(values.items()))
 
     functions = {name: registry.FUNCTIONS[name] for name in FK_KERNELS}
+    fkj = {"forward_kinematics_jacobian": registry.FUNCTIONS["forward_kinematics_jacobian"]}
     files = generate.render(
-        (structures.from_variant(actuation),), {**functions, "forward_kinematics": builder}
+        (structures.from_variant(actuation),), {**functions, "forward_kinematics": builder, **fkj}
     )
     folder.mkdir(parents=True)
     for name in ("rpr3.c", "rpr3.h"):
@@ -112,7 +113,8 @@ def _build(folder: Path, actuation: str, **context: object) -> ctypes.CDLL:
 @pytest.fixture(scope="module")
 def traced(tmp_path_factory) -> Callable[..., Traced]:
     """``traced(actuation, **context)``: a function ``(params, qa, q_near) -> (code, q, steps,
-    how)`` of a test-only build, built once per actuation and context."""
+    how)`` of a test-only build, built once per actuation and context; its ``library`` holds
+    the build's other functions (``rpr3_forward_kinematics_jacobian`` calls the traced body)."""
     libraries: dict[tuple, ctypes.CDLL] = {}
 
     def get(actuation: str, **context: object) -> Traced:
@@ -137,6 +139,7 @@ def traced(tmp_path_factory) -> Callable[..., Traced]:
             lib.last_trace(trace)
             return code, q, trace[0], HOW.get(trace[1], "not traced")
 
+        call.library = lib  # type: ignore[attr-defined]  # its other functions, for a test
         return call
 
     return get
@@ -475,6 +478,93 @@ def test_single_and_batch_are_bit_identical(actuation: str) -> None:
         counts += np.bincount(codes, minlength=4)
     assert counts[0] >= evaluated
     assert counts[3] >= 6
+
+
+def _fk_jacobian(model: Model, qa, near) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    (q, J), codes = rpr3gen.evaluate(model, "forward_kinematics_jacobian", (qa, near), backend="c")
+    return q, J, codes
+
+
+@pytest.mark.parametrize("actuation", ACTUATIONS)
+def test_forward_kinematics_jacobian_is_fk_then_the_jacobian(actuation: str) -> None:
+    """``rpr3_forward_kinematics_jacobian``: the pose and the return code of
+    ``rpr3_forward_kinematics``, and the Jacobian of ``rpr3_actuator_jacobian`` at that pose, bit
+    for bit; references near (Newton), far (the fallback too) and inputs with no mode or not
+    finite; the single call the batch's, and a failed call leaves both outputs."""
+    rng = np.random.default_rng(36)
+    codes_seen = np.zeros(4, dtype=int)
+    for params in fk.robots(rng, 3):
+        model = _model(params, actuation)
+        poses = fk.evaluable(fk.Geometry.from_params(params), fk.random_poses(rng, 40))
+        qa = np.concatenate([_qa(params, actuation, poses), _no_mode_inputs(actuation)])
+        near = np.concatenate(
+            [
+                poses + rng.normal(0, [0.05, 0.05, 0.5], poses.shape),
+                np.zeros((len(qa) - len(poses), 3)),
+            ]
+        )
+        qa[1, 0] = np.nan
+        q, codes = _fk(model, qa, near)
+        q2, J2, codes2 = _fk_jacobian(model, qa, near)
+        assert np.array_equal(codes2, codes)
+        assert np.array_equal(q2, q, equal_nan=True)
+        ok = codes == 0
+        (J,), jacobian_codes = rpr3gen.evaluate(model, "actuator_jacobian", (q[ok],), backend="c")
+        assert (jacobian_codes == 0).all()
+        assert np.array_equal(J2[ok], J)
+        assert np.isnan(J2[~ok]).all()
+        evaluator = rpr3gen.SampleEvaluator(
+            model, backend="c", function="forward_kinematics_jacobian"
+        )
+        for k in range(len(qa)):
+            evaluator.q[:] = 7.0
+            evaluator.J[:] = 7.0
+            evaluator.qa[:] = qa[k]
+            evaluator.q_near[:] = near[k]
+            assert evaluator() == codes[k]
+            if codes[k] == 0:
+                assert np.array_equal(evaluator.q, q2[k])
+                assert np.array_equal(evaluator.J, J2[k])
+            else:
+                assert (evaluator.q == 7.0).all()
+                assert (evaluator.J == 7.0).all()
+        codes_seen += np.bincount(codes, minlength=4)
+    assert codes_seen[0] >= 100
+    assert codes_seen[1] == 3
+    assert codes_seen[3] >= 6
+
+
+@pytest.mark.parametrize("actuation", ACTUATIONS)
+def test_forward_kinematics_jacobian_after_the_fallback(actuation: str, traced) -> None:
+    """With Newton cut to no step (a test-only build, ``max_iter=0``), every pose comes from the
+    fallback, whose mode's phi is unwrapped next to the reference: the Jacobian returned is still
+    ``rpr3_actuator_jacobian``'s at the pose returned, bit for bit."""
+    lib = traced(actuation, max_iter=0).library
+    rng = np.random.default_rng(37)
+    params = dict(rpr3gen.load_model().params)
+    geom = fk.Geometry.from_params(params)
+    poses = fk.evaluable(geom, fk.random_poses(rng, 40))
+    qa = _qa(params, actuation, poses)
+    near = poses + rng.normal(0, [0.01, 0.01, 0.1], poses.shape)
+    near[:, 2] += 2.0 * np.pi * rng.integers(-2, 3, len(near))  # phi unwrapped by whole turns
+    p = np.array([params[name] for name in paper.PARAM_NAMES], dtype=np.float64)
+    fallbacks = 0
+    for k in range(len(qa)):
+        q = np.full(3, np.nan)
+        J = np.full(9, np.nan)
+        trace = (ctypes.c_int * 2)(-1, -1)
+        ptr = ctypes.c_void_p
+        args = [ptr(a.ctypes.data) for a in (p, np.ascontiguousarray(qa[k]), near[k].copy())]
+        code = lib.rpr3_forward_kinematics_jacobian(*args, ptr(q.ctypes.data), ptr(J.ctypes.data))
+        lib.last_trace(trace)
+        assert code == 0
+        fallbacks += trace[1] == 1
+        assert abs(q[2] - near[k, 2]) < np.pi + 1e-9  # unwrapped next to the reference
+        expected = np.full(9, np.nan)
+        assert lib.rpr3_actuator_jacobian(ptr(p.ctypes.data), ptr(q.ctypes.data),
+                                          ptr(expected.ctypes.data)) == 0  # fmt: skip
+        assert np.array_equal(J, expected)
+    assert fallbacks == len(qa) >= 15
 
 
 # ----------------------------------------------------------------------------------------------

@@ -257,7 +257,9 @@ def test_assembly_modes_round_trip(name: str) -> None:
 @pytest.mark.parametrize("name", NAMES)
 def test_c_tracked_forward_kinematics(name: str, private_root) -> None:
     """The generated C's tracked forward kinematics from references near the poses of the motion
-    (a few mm and 0.6 degree off) returns the poses, with the angle next to the reference's."""
+    (a few mm and 0.6 degree off) returns the poses, with the angle next to the reference's;
+    ``forward_kinematics_jacobian`` returns them too, with the actuator Jacobian there, bit for
+    bit ``actuator_jacobian``'s."""
     c = _case(name)
     m = _c_model(name, private_root)
     rho = rpr3gen.platform_radius(m)
@@ -268,6 +270,10 @@ def test_c_tracked_forward_kinematics(name: str, private_root) -> None:
     found = rpr3gen.forward_kinematics(m, qa, near, backend="c")
     assert np.max(_distance(found, c.q, rho)) < 1e-10 * rho
     assert np.max(np.abs(found[:, 2] - 2 * np.pi - c.q[:, 2])) < 1e-10
+    (q, J), codes = rpr3gen.evaluate(m, "forward_kinematics_jacobian", (qa, near), backend="c")
+    assert (codes == 0).all()
+    assert np.array_equal(q, found)
+    assert np.array_equal(J.reshape(-1, 3, 3), rpr3gen.actuator_jacobian(m, found, backend="c"))
 
 
 def _inputs(c: Case, qa: np.ndarray) -> dict[str, np.ndarray]:

@@ -6,8 +6,9 @@
  * (rpr3_actuator_coordinates) rounded to whole encoder counts: 2^17 counts per revolution
  * (revolute actuation) or 1 um per count (prismatic). Controller, nominal model, every tick:
  *   qa    = counts * resolution;  qa' = (counts - previous counts) * resolution / dt, low-pass
- *   q     = rpr3_forward_kinematics(qa, q_near = 2 q[k-1] - q[k-2])   (tracked)
- *   q'    : J(q) q' = qa'                                              (rpr3_actuator_jacobian)
+ *   q, J  = rpr3_forward_kinematics_jacobian(qa, q_near = 2 q[k-1] - q[k-2])
+ *           (tracked; J = d qa / d q at q, which the tracked Newton evaluated there)
+ *   q'    : J q' = qa'
  *   M, c  = rpr3_task_space_dynamics(q, q')
  *   tau   : J^T tau = M (qdd_d + Kd (qd_d - q') + Kp (q_d - q)) + c
  * Prints the tracking error, the pose and velocity estimates' errors, the failed calls and the
@@ -242,20 +243,20 @@ static void controller_tick(struct controller *ctl, const long *counts, double t
     }
     ctl->started = 1;
 
-    /* the pose: tracked forward kinematics from the prediction */
-    status = rpr3_forward_kinematics(ctl->params, qa, near, q);
+    /* the pose and J there: tracked forward kinematics from the prediction */
+    status = rpr3_forward_kinematics_jacobian(ctl->params, qa, near, q, J);
     if (split) {
         fk_end = now_ns();
     }
     if (status != RPR3_OK) {
         ++ctl->failed_fk;
-        memcpy(q, near, sizeof q); /* coast on the prediction */
+        memcpy(q, near, sizeof q); /* coast on the prediction, with its J */
+        status = rpr3_actuator_jacobian(ctl->params, q, J);
     }
     memcpy(ctl->q2, first ? q : ctl->q1, sizeof q); /* at first, at rest */
     memcpy(ctl->q1, q, sizeof q);
 
-    if (rpr3_actuator_jacobian(ctl->params, q, J) != RPR3_OK
-        || solve3(J, ctl->rate, 0, ctl->qd) != 0) { /* the velocity: J q' = qa' */
+    if (status != RPR3_OK || solve3(J, ctl->rate, 0, ctl->qd) != 0) { /* the velocity: J q' = qa' */
         ++ctl->failed_jacobian;
         finish(start, fk_end, split, ns);
         return; /* hold the last efforts */

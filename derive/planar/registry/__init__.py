@@ -33,6 +33,7 @@ from rpr3gen_derive.planar.registry.direct_kinematics import (
     assembly_modes,
     fk_kind,
     forward_kinematics,
+    forward_kinematics_jacobian,
     locked_circles,
     pose_from_angle,
 )
@@ -106,6 +107,7 @@ FUNCTIONS: Mapping[str, FunctionBuilder] = {
     "pose_from_angle": pose_from_angle,
     "locked_circles": locked_circles,
     "forward_kinematics": forward_kinematics,
+    "forward_kinematics_jacobian": forward_kinematics_jacobian,
     "regressor": regressor,
     "payload_efforts": payload_efforts,
 }

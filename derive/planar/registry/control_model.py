@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import sympy as sp
 from rpr3gen_derive.codegen.program import Program
-from rpr3gen_derive.codegen.spec import Argument, Component, FunctionSpec
+from rpr3gen_derive.codegen.spec import Argument, Component, FunctionSpec, Output
 from rpr3gen_derive.planar import control
 from rpr3gen_derive.planar import symbols as syms
 from rpr3gen_derive.planar.registry.arguments import (
@@ -40,26 +40,31 @@ def actuator_coordinates(structure: Structure) -> FunctionSpec:
     )
 
 
+def jacobian_output(structure: Structure, J: sp.Matrix, name: str = "J", **kw: bool) -> Output:
+    """The output ``J = d qa / d q`` (row-major, components ``J11`` ... ``J33``) of the matrix
+    ``J``: :func:`actuator_jacobian`'s, and the forward kinematics' (``kw``: ``hidden``)."""
+    units = ("1/m", "1/m", "1") if structure.actuated_kind == "R" else ("1", "1", "m")
+    qa_names = [c.name for c in actuator_argument(structure).components]
+    out = matrix_output(
+        "J",
+        J,
+        units,
+        "J = d qa / d q, row-major",
+        lambda i, j: f"d {qa_names[i]} / d {POSE.components[j].name}",
+    )
+    return Output(name, out.exprs, out.components, out.doc, **kw)
+
+
 def actuator_jacobian(structure: Structure) -> FunctionSpec:
     """``rpr3_actuator_jacobian``: ``J = d qa / d q``, row-major, so that ``qa' = J q'``."""
     prog = Program()
     J = control.actuator_jacobian(prog, structure)
-    units = ("1/m", "1/m", "1") if structure.actuated_kind == "R" else ("1", "1", "m")
-    qa_names = [c.name for c in actuator_argument(structure).components]
     return FunctionSpec(
         name="actuator_jacobian",
         doc="Actuator Jacobian J = d qa / d q (eq. 6 differentiated), row-major, one row per "
         "leg A, B, C: qa' = J q'. det J = 0 at a parallel singularity.",
         inputs=(POSE,),
-        outputs=(
-            matrix_output(
-                "J",
-                J,
-                units,
-                "J = d qa / d q, row-major",
-                lambda i, j: f"d {qa_names[i]} / d {POSE.components[j].name}",
-            ),
-        ),
+        outputs=(jacobian_output(structure, J),),
         program=prog,
         checks=pose_checks(prog, structure),
     )

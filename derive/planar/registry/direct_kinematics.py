@@ -10,6 +10,7 @@ from rpr3gen_derive.codegen.spec import Argument, Check, Component, FunctionSpec
 from rpr3gen_derive.planar import direct_kinematics, structures
 from rpr3gen_derive.planar.geometry import LEGS
 from rpr3gen_derive.planar.registry.arguments import POSE, actuator_argument
+from rpr3gen_derive.planar.registry.control_model import jacobian_output
 from rpr3gen_derive.planar.structures import Structure
 
 
@@ -210,7 +211,8 @@ def forward_kinematics(structure: Structure) -> FunctionSpec:
 
     The numbers are :data:`FK_TUNING`; ``trace=True`` (test builds only) makes the body call
     ``rpr3_fk_trace(steps, how)`` (``how``: 0 Newton, 1 fallback, 2 none), which the test's
-    harness defines.
+    harness defines. Its hidden output ``jacobian`` is the actuator Jacobian at the pose found,
+    which its Newton evaluated there: :func:`forward_kinematics_jacobian` returns it.
     """
     qa = actuator_argument(structure)
     near = Argument(
@@ -228,7 +230,10 @@ def forward_kinematics(structure: Structure) -> FunctionSpec:
         name="forward_kinematics",
         doc=_forward_kinematics_doc(structure),
         inputs=(qa, near),
-        outputs=(Output("q", (sp.Integer(0),) * 3, POSE.components, "the pose found"),),
+        outputs=(
+            Output("q", (sp.Integer(0),) * 3, POSE.components, "the pose found"),
+            jacobian_output(structure, sp.zeros(3, 3), "jacobian", hidden=True),
+        ),
         program=Program(),
         checks=(Check("inputs_not_finite", "NOT_FINITE"), Check("custom", "NO_MODE")),
         c_body="forward_kinematics.c.jinja",
@@ -243,4 +248,30 @@ def forward_kinematics(structure: Structure) -> FunctionSpec:
             *FK_TUNING,
             ("trace", False),
         ),
+    )
+
+
+def forward_kinematics_jacobian(structure: Structure) -> FunctionSpec:
+    """``rpr3_forward_kinematics_jacobian``: the tracked forward kinematics and the actuator
+    Jacobian at the pose it finds, in one call.
+
+    C only: its body (``templates/forward_kinematics_jacobian.c.jinja``) is the call of
+    :func:`forward_kinematics`' kernel, whose hidden output is that Jacobian: its Newton
+    evaluated it at the pose it accepts (by ``actuator_jacobian``'s values-only kernel, so the
+    bits of ``rpr3_actuator_jacobian``), and its fallback evaluates it at the mode it returns. A
+    control tick that needs J right after the pose (the velocity from ``J q' = qa'``, the
+    efforts from ``J^T tau = ...``) saves the second evaluation.
+    """
+    fk = forward_kinematics(structure)
+    return FunctionSpec(
+        name="forward_kinematics_jacobian",
+        doc="Tracked forward kinematics and the actuator Jacobian at the pose found, in one call: "
+        "q is forward_kinematics' (same bits, same return code), J = d qa / d q at q, row-major, "
+        "the bits of actuator_jacobian at q (the tracked Newton evaluated it there). Non-zero, "
+        "q and J untouched, when there is no mode.",
+        inputs=fk.inputs,
+        outputs=(fk.output("q"), jacobian_output(structure, sp.zeros(3, 3))),
+        program=Program(),
+        checks=fk.checks,
+        c_body="forward_kinematics_jacobian.c.jinja",
     )
