@@ -57,3 +57,12 @@ def run_command(argv: list[str]) -> int:
     parquet.write_table = reporting
     sweeps.evaluate_chunk = chunk_or_block
     return main(argv)
+
+
+def start_and_block(name: str) -> None:
+    """Set the Dask event ``name`` (the test then knows the task runs) and block for good: a
+    task that never returns, not even when its worker closes."""
+    from distributed import Event
+
+    Event(name).set()
+    threading.Event().wait()

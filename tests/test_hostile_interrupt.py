@@ -21,7 +21,7 @@ import hostile_sweep_tasks as tasks
 import pytest
 
 from rpr3gen.cli import main
-from rpr3gen.design import sweeps
+from rpr3gen.design import cluster, sweeps
 from rpr3gen.design.metrics import evaluate_chunk
 
 TESTS = Path(__file__).resolve().parent
@@ -30,18 +30,22 @@ LINE_LIMIT = 120.0
 FINISHED = [f"chunk-{i:06d}.parquet" for i in range(tasks.FINISHED)]
 
 
-def _lines(proc: subprocess.Popen[str]) -> Any:
-    """The command's stderr, line by line, each within :data:`LINE_LIMIT` seconds."""
+def _lines(proc: subprocess.Popen[str], log: list[str]) -> Any:
+    """The command's stderr, line by line, each within :data:`LINE_LIMIT` seconds; every line
+    read is also appended to ``log`` (a failure shows them all)."""
     assert proc.stderr is not None
     with selectors.DefaultSelector() as selector:
         selector.register(proc.stderr, selectors.EVENT_READ)
         while True:
             if not selector.select(timeout=LINE_LIMIT):
                 proc.kill()
-                pytest.fail(f"no line from the sweep for {LINE_LIMIT:g} s")
+                pytest.fail(
+                    f"no line from the sweep for {LINE_LIMIT:g} s; it said:\n{''.join(log)}"
+                )
             line = proc.stderr.readline()
             if not line:
                 return
+            log.append(line)
             yield line
 
 
@@ -67,7 +71,8 @@ def test_ctrl_c_keeps_every_finished_chunk_says_one_line_and_resume_finishes(
         start_new_session=True,  # its own process group, as a command in a terminal
     ) as proc:
         seen, written, blocked = [], set(), False
-        for line in _lines(proc):
+        log: list[str] = []
+        for line in _lines(proc, log):
             seen.append(line)
             written |= {Path(line.split()[-1]).name} if line.startswith(tasks.WROTE) else set()
             blocked = blocked or line.startswith(tasks.BLOCKED)
@@ -76,7 +81,7 @@ def test_ctrl_c_keeps_every_finished_chunk_says_one_line_and_resume_finishes(
         else:
             pytest.fail(f"the sweep ended before Ctrl-C: {''.join(seen)}")
         os.killpg(proc.pid, signal.SIGINT)  # a terminal's Ctrl-C: every process of the command
-        after = list(_lines(proc))
+        after = list(_lines(proc, log))
         assert proc.wait() == 130
     # A chunk written as Ctrl-C came may be written again (kept as finished): the same bytes.
     rest = "".join(line for line in after if not line.startswith(tasks.WROTE))
@@ -105,3 +110,27 @@ def test_ctrl_c_keeps_every_finished_chunk_says_one_line_and_resume_finishes(
     assert out.read_bytes() == straight.read_bytes()
     assert not parts.exists()
     assert capsys.readouterr().err == ""
+
+
+def test_a_task_that_never_returns_does_not_outlive_the_interrupted_command(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """After a Ctrl-C the local cluster gets ``CLOSE_TIMEOUT`` to close; a worker whose task
+    never returns (and ignores the worker's closing) is then killed, so that the command ends
+    instead of waiting on it at exit."""
+    from distributed import Event
+
+    monkeypatch.setattr(cluster.ClusterClient, "CLOSE_TIMEOUT", 1.0)
+    local = cluster.ClusterClient(None, 1)
+    client = local.__enter__()
+    try:
+        future = client.submit(tasks.start_and_block, "hostile-started", pure=False)
+        assert Event("hostile-started", client=client).wait(timeout=LINE_LIMIT)  # a hang guard
+        workers = local.leftover_workers()
+        assert len(workers) == 1
+        assert workers[0].is_alive()
+        assert not future.done()
+    finally:
+        local.close_quietly()
+    assert local.leftover_workers() == []
+    assert not workers[0].is_alive()
