@@ -45,8 +45,17 @@ def chunk_or_block(plan: Any, index: int) -> Any:
 
 def run_command(argv: list[str]) -> int:
     """``rpr3gen`` with the sweep's tasks replaced and each part file reported."""
+    import faulthandler
+    import signal
+
     from rpr3gen.cli import main
     from rpr3gen.design import parquet, sweeps
+
+    faulthandler.register(signal.SIGUSR1, all_threads=True)  # the test's view of a hang
+    # A command started from a terminal has SIGINT's default action; one started by a
+    # non-interactive shell in the background (``pytest ... &``) inherits it ignored, and Python
+    # then leaves it ignored. The test sends a terminal's Ctrl-C: make it one that can be heard.
+    signal.signal(signal.SIGINT, signal.default_int_handler)
 
     write_table = parquet.write_table
 
@@ -57,12 +66,3 @@ def run_command(argv: list[str]) -> int:
     parquet.write_table = reporting
     sweeps.evaluate_chunk = chunk_or_block
     return main(argv)
-
-
-def start_and_block(name: str) -> None:
-    """Set the Dask event ``name`` (the test then knows the task runs) and block for good: a
-    task that never returns, not even when its worker closes."""
-    from distributed import Event
-
-    Event(name).set()
-    threading.Event().wait()

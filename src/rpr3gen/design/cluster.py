@@ -10,16 +10,13 @@ the local cluster's workers too, which would die mid-task with tracebacks. So th
 with SIGINT blocked (:func:`_workers_deaf_to_ctrl_c`); only this process sees it. It then keeps
 every chunk that has finished (:func:`_keep_finished`), cancels the rest and shuts the cluster
 down with Dask's loggers silenced and further Ctrl-C ignored until it is down
-(:meth:`ClusterClient.close_quietly`), and raises ``KeyboardInterrupt``. A local worker that has
-not stopped once the shutdown's time is up (a task that does not return, a loaded machine) is
-killed: the command ends, it does not wait on it at exit.
+(:meth:`ClusterClient.close_quietly`), and raises ``KeyboardInterrupt``.
 """
 
 from __future__ import annotations
 
 import contextlib
 import logging
-import multiprocessing
 import os
 import signal
 import sys
@@ -34,9 +31,6 @@ from rpr3gen.errors import Rpr3genError
 __all__ = ["MALLOC_TRIM", "ClusterClient", "run_chunks", "task_result"]
 
 Columns = dict[str, Any]
-
-#: The name Dask's nanny gives the worker process it starts (``distributed.nanny``).
-WORKER_PROCESS = "Dask Worker process (from Nanny)"
 
 #: Dask's setting that makes its worker processes return freed memory to the system beyond 64 KiB
 #: (``MALLOC_TRIM_THRESHOLD_``). With it, glibc maps and unmaps every large NumPy temporary of
@@ -123,16 +117,11 @@ def task_result(future: Any) -> tuple[int, Columns]:
 class ClusterClient:
     """A Dask client of the scheduler at ``address``, or of a local cluster made for the run."""
 
-    #: Seconds the client and the cluster each get to close after a Ctrl-C; a local worker
-    #: still running after that is killed (:meth:`close_quietly`).
-    CLOSE_TIMEOUT = 10.0
-
     def __init__(self, address: str | None, workers: int | None) -> None:
         self.address = address
         self.workers = workers
         self.cluster: Any = None
         self.client: Any = None
-        self.children: set[Any] = set()  # this process's children before the local cluster
 
     def __enter__(self) -> Any:
         import dask
@@ -145,7 +134,6 @@ class ClusterClient:
                 raise Rpr3genError(f"scheduler {self.address}: cannot connect: {exc}") from None
             return self.client
         n = self.workers or len(os.sched_getaffinity(0))
-        self.children = set(multiprocessing.active_children())
         try:
             with dask.config.set({MALLOC_TRIM: None}), _workers_deaf_to_ctrl_c():
                 self.cluster = LocalCluster(
@@ -180,18 +168,7 @@ class ClusterClient:
             for closing in (self.client, self.cluster):
                 if closing is not None:
                     with contextlib.suppress(Exception):
-                        closing.close(timeout=self.CLOSE_TIMEOUT)
-            for process in self.leftover_workers():
-                with contextlib.suppress(Exception):
-                    process.kill()
-                    process.join(timeout=self.CLOSE_TIMEOUT)
-
-    def leftover_workers(self) -> list[Any]:
-        """The local cluster's worker processes still alive (none on a scheduler's cluster)."""
-        if self.cluster is None:
-            return []
-        return [p for p in multiprocessing.active_children()
-                if p not in self.children and p.name == WORKER_PROCESS]  # fmt: skip
+                        closing.close(timeout=10)
 
 
 def _main_thread() -> bool:
