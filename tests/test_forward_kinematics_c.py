@@ -489,8 +489,9 @@ def _fk_jacobian(model: Model, qa, near) -> tuple[np.ndarray, np.ndarray, np.nda
 def test_forward_kinematics_jacobian_is_fk_then_the_jacobian(actuation: str) -> None:
     """``rpr3_forward_kinematics_jacobian``: the pose and the return code of
     ``rpr3_forward_kinematics``, and the Jacobian of ``rpr3_actuator_jacobian`` at that pose, bit
-    for bit; references near (Newton), far (the fallback too) and inputs with no mode or not
-    finite; the single call the batch's, and a failed call leaves both outputs."""
+    for bit; references a few cm and half a radian off, inputs with no mode or not finite; the
+    single call the batch's, and a failed call leaves both outputs. (The fallback's path, forced,
+    is the next test's.)"""
     rng = np.random.default_rng(36)
     codes_seen = np.zeros(4, dtype=int)
     for params in fk.robots(rng, 3):
