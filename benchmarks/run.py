@@ -45,7 +45,7 @@ PYPERF: dict[str, tuple[list[str], list[str] | None]] = {
     "numpy": (["--processes", "2", "--values", "3"], ["--processes", "1", "--values", "1"]),
     "large": (["--processes", "1", "--values", "2", "--loops", "1"], None),
     "functions": (["--processes", "2", "--values", "3"], ["--processes", "1", "--values", "1"]),
-    # 18 structures x 13 functions: one process each, no calibration (a call takes milliseconds)
+    # 18 structures x 14 functions: one process each, no calibration (a call takes milliseconds)
     "structures": (
         ["--processes", "1", "--values", "3", "--loops", "1"],
         ["--processes", "1", "--values", "1", "--loops", "1"],

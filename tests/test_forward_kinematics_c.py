@@ -75,7 +75,7 @@ void last_trace(int out[2])
 """
 FK_KERNELS = (
     "actuator_coordinates",
-    "actuator_jacobian",
+    "actuator_coordinates_jacobian",
     "jacobian_rate",
     "assembly_modes",
     "pose_from_angle",
@@ -488,10 +488,10 @@ def _fk_jacobian(model: Model, qa, near) -> tuple[np.ndarray, np.ndarray, np.nda
 @pytest.mark.parametrize("actuation", ACTUATIONS)
 def test_forward_kinematics_jacobian_is_fk_then_the_jacobian(actuation: str) -> None:
     """``rpr3_forward_kinematics_jacobian``: the pose and the return code of
-    ``rpr3_forward_kinematics``, and the Jacobian of ``rpr3_actuator_jacobian`` at that pose, bit
-    for bit; references a few cm and half a radian off, inputs with no mode or not finite; the
-    single call the batch's, and a failed call leaves both outputs. (The fallback's path, forced,
-    is the next test's.)"""
+    ``rpr3_forward_kinematics``, and the Jacobian of ``rpr3_actuator_coordinates_jacobian`` at
+    that pose, bit for bit (``rpr3_actuator_jacobian``'s to round-off); references a few cm and
+    half a radian off, inputs with no mode or not finite; the single call the batch's, and a
+    failed call leaves both outputs. (The fallback's path, forced, is the next test's.)"""
     rng = np.random.default_rng(36)
     codes_seen = np.zeros(4, dtype=int)
     for params in fk.robots(rng, 3):
@@ -510,9 +510,13 @@ def test_forward_kinematics_jacobian_is_fk_then_the_jacobian(actuation: str) -> 
         assert np.array_equal(codes2, codes)
         assert np.array_equal(q2, q, equal_nan=True)
         ok = codes == 0
-        (J,), jacobian_codes = rpr3gen.evaluate(model, "actuator_jacobian", (q[ok],), backend="c")
+        (_, J), jacobian_codes = rpr3gen.evaluate(
+            model, "actuator_coordinates_jacobian", (q[ok],), backend="c"
+        )
         assert (jacobian_codes == 0).all()
         assert np.array_equal(J2[ok], J)
+        alone = rpr3gen.actuator_jacobian(model, q[ok], backend="c").reshape(-1, 9)
+        assert np.max(np.abs(J - alone) / np.max(np.abs(alone), axis=1, keepdims=True)) < 1e-14
         assert np.isnan(J2[~ok]).all()
         evaluator = rpr3gen.SampleEvaluator(
             model, backend="c", function="forward_kinematics_jacobian"
@@ -539,7 +543,7 @@ def test_forward_kinematics_jacobian_is_fk_then_the_jacobian(actuation: str) -> 
 def test_forward_kinematics_jacobian_after_the_fallback(actuation: str, traced) -> None:
     """With Newton cut to no step (a test-only build, ``max_iter=0``), every pose comes from the
     fallback, whose mode's phi is unwrapped next to the reference: the Jacobian returned is still
-    ``rpr3_actuator_jacobian``'s at the pose returned, bit for bit."""
+    ``rpr3_actuator_coordinates_jacobian``'s at the pose returned, bit for bit."""
     lib = traced(actuation, max_iter=0).library
     rng = np.random.default_rng(37)
     params = dict(rpr3gen.load_model().params)
@@ -561,9 +565,11 @@ def test_forward_kinematics_jacobian_after_the_fallback(actuation: str, traced) 
         assert code == 0
         fallbacks += trace[1] == 1
         assert abs(q[2] - near[k, 2]) < np.pi + 1e-9  # unwrapped next to the reference
-        expected = np.full(9, np.nan)
-        assert lib.rpr3_actuator_jacobian(ptr(p.ctypes.data), ptr(q.ctypes.data),
-                                          ptr(expected.ctypes.data)) == 0  # fmt: skip
+        expected, qa_back = np.full(9, np.nan), np.full(3, np.nan)
+        assert lib.rpr3_actuator_coordinates_jacobian(
+            ptr(p.ctypes.data), ptr(q.ctypes.data), ptr(qa_back.ctypes.data),
+            ptr(expected.ctypes.data)
+        ) == 0  # fmt: skip
         assert np.array_equal(J, expected)
     assert fallbacks == len(qa) >= 15
 

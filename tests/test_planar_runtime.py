@@ -259,7 +259,7 @@ def test_c_tracked_forward_kinematics(name: str, private_root) -> None:
     """The generated C's tracked forward kinematics from references near the poses of the motion
     (a few mm and 0.6 degree off) returns the poses, with the angle next to the reference's;
     ``forward_kinematics_jacobian`` returns them too, with the actuator Jacobian there, bit for
-    bit ``actuator_jacobian``'s."""
+    bit ``actuator_coordinates_jacobian``'s."""
     c = _case(name)
     m = _c_model(name, private_root)
     rho = rpr3gen.platform_radius(m)
@@ -273,7 +273,46 @@ def test_c_tracked_forward_kinematics(name: str, private_root) -> None:
     (q, J), codes = rpr3gen.evaluate(m, "forward_kinematics_jacobian", (qa, near), backend="c")
     assert (codes == 0).all()
     assert np.array_equal(q, found)
-    assert np.array_equal(J.reshape(-1, 3, 3), rpr3gen.actuator_jacobian(m, found, backend="c"))
+    (_, expected), _ = rpr3gen.evaluate(m, "actuator_coordinates_jacobian", (found,), "c")
+    assert np.array_equal(J, expected)
+
+
+def _relative(a: np.ndarray, b: np.ndarray) -> float:
+    """The largest difference of two stacks of rows, relative to each row's largest value."""
+    a, b = a.reshape(len(a), -1), b.reshape(len(b), -1)
+    return float(np.max(np.abs(a - b) / np.max(np.abs(b), axis=1, keepdims=True)))
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_actuator_coordinates_jacobian_is_both_functions(name: str, private_root) -> None:
+    """``actuator_coordinates_jacobian`` gives ``actuator_coordinates``' and
+    ``actuator_jacobian``'s values to round-off, in C and in NumPy (one elimination of common
+    subexpressions over both may group a sum differently; measured: the same bits but for the C
+    of two structures, prp1's qa 6.0e-16 and rpp2's J 5.8e-17 relative); its ``J`` is the
+    central difference of its own ``qa`` (a check independent of the derivation's
+    differentiation; measured 1.5e-11 to 5.9e-10 relative, steps of 1e-6 m and 1e-6 m / rho)."""
+    c = _case(name)
+    cm = _c_model(name, private_root)
+    for model, backend in ((cm, "c"), (c.model, "numpy")):
+        (qa, J), codes = rpr3gen.evaluate(model, "actuator_coordinates_jacobian", (c.q,), backend)
+        assert (codes == 0).all()
+        alone = rpr3gen.actuator_coordinates(model, c.q, backend=backend)
+        J_alone = rpr3gen.actuator_jacobian(model, c.q, backend=backend)
+        assert _relative(qa, alone) < 1e-14, backend
+        assert _relative(J, J_alone) < 1e-14, backend
+    (qa, J), _ = rpr3gen.evaluate(cm, "actuator_coordinates_jacobian", (c.q,), "c")
+    rho = rpr3gen.platform_radius(cm)
+    J = J.reshape(-1, 3, 3)
+    difference = np.empty_like(J)
+    for j, step in enumerate((1e-6, 1e-6, 1e-6 / rho)):
+        h = np.zeros(3)
+        h[j] = step
+        (up, _), _ = rpr3gen.evaluate(cm, "actuator_coordinates_jacobian", (c.q + h,), "c")
+        (down, _), _ = rpr3gen.evaluate(cm, "actuator_coordinates_jacobian", (c.q - h,), "c")
+        difference[:, :, j] = (up - down) / (2 * step)
+    # columns in (x, y, rho phi): the angle's column scaled by 1/rho
+    scaled = np.array([1.0, 1.0, 1.0 / rho])
+    assert _relative(difference * scaled, J * scaled) < 1e-7
 
 
 def _inputs(c: Case, qa: np.ndarray) -> dict[str, np.ndarray]:

@@ -70,6 +70,29 @@ def actuator_jacobian(structure: Structure) -> FunctionSpec:
     )
 
 
+def actuator_coordinates_jacobian(structure: Structure) -> FunctionSpec:
+    """``rpr3_actuator_coordinates_jacobian``: ``qa`` and ``J = d qa / d q`` of a pose in one
+    call (eqs. 5, 6), their common terms (the platform's rotation, each leg's geometry)
+    evaluated once: the values of :func:`actuator_coordinates` and :func:`actuator_jacobian` to
+    round-off (one common subexpression elimination over both may group a sum differently).
+    The tracked forward kinematics' Newton evaluates both at every iterate with it."""
+    prog = Program()
+    values = sp.Matrix(control.actuator_values(prog, structure, "q"))
+    J = control.actuator_jacobian(prog, structure)
+    qa = actuator_argument(structure)
+    return FunctionSpec(
+        name="actuator_coordinates_jacobian",
+        doc=f"Actuator coordinates qa ({qa.doc}) of the platform pose q (eq. 5) and the actuator "
+        "Jacobian J = d qa / d q there (eq. 6 differentiated), row-major, in one call, their "
+        "common terms evaluated once: actuator_coordinates' and actuator_jacobian's values to "
+        "round-off.",
+        inputs=(POSE,),
+        outputs=(output_like("qa", values, qa, qa.doc), jacobian_output(structure, J)),
+        program=prog,
+        checks=pose_checks(prog, structure),
+    )
+
+
 def jacobian_rate(structure: Structure) -> FunctionSpec:
     """``rpr3_jacobian_rate``: ``J' q'``, so that ``qa'' = J q'' + J' q'`` (eq. 9)."""
     prog = Program()

@@ -212,7 +212,8 @@ def forward_kinematics(structure: Structure) -> FunctionSpec:
     The numbers are :data:`FK_TUNING`; ``trace=True`` (test builds only) makes the body call
     ``rpr3_fk_trace(steps, how)`` (``how``: 0 Newton, 1 fallback, 2 none), which the test's
     harness defines. Its hidden output ``jacobian`` is the actuator Jacobian at the pose found,
-    which its Newton evaluated there: :func:`forward_kinematics_jacobian` returns it.
+    which its Newton evaluated there (``actuator_coordinates_jacobian``'s values kernel gives
+    the residual and J at every iterate): :func:`forward_kinematics_jacobian` returns it.
     """
     qa = actuator_argument(structure)
     near = Argument(
@@ -238,7 +239,7 @@ def forward_kinematics(structure: Structure) -> FunctionSpec:
         checks=(Check("inputs_not_finite", "NOT_FINITE"), Check("custom", "NO_MODE")),
         c_body="forward_kinematics.c.jinja",
         c_kernels=("minmax",),
-        c_values=("actuator_coordinates", "actuator_jacobian", "jacobian_rate"),
+        c_values=("actuator_coordinates_jacobian", "jacobian_rate"),
         c_context=(
             ("kind", fk_kind(structure)),
             ("wrap", structure.actuated_kind == "R"),
@@ -257,8 +258,9 @@ def forward_kinematics_jacobian(structure: Structure) -> FunctionSpec:
 
     C only: its body (``templates/forward_kinematics_jacobian.c.jinja``) is the call of
     :func:`forward_kinematics`' kernel, whose hidden output is that Jacobian: its Newton
-    evaluated it at the pose it accepts (by ``actuator_jacobian``'s values-only kernel, so the
-    bits of ``rpr3_actuator_jacobian``), and its fallback evaluates it at the mode it returns. A
+    evaluated it at the pose it accepts (by ``actuator_coordinates_jacobian``'s kernels, so the
+    bits of ``rpr3_actuator_coordinates_jacobian``), and its fallback evaluates it at the mode
+    it returns. A
     control tick that needs J right after the pose (the velocity from ``J q' = qa'``, the
     efforts from ``J^T tau = ...``) saves the second evaluation.
     """
@@ -267,7 +269,8 @@ def forward_kinematics_jacobian(structure: Structure) -> FunctionSpec:
         name="forward_kinematics_jacobian",
         doc="Tracked forward kinematics and the actuator Jacobian at the pose found, in one call: "
         "q is forward_kinematics' (same bits, same return code), J = d qa / d q at q, row-major, "
-        "the bits of actuator_jacobian at q (the tracked Newton evaluated it there). Non-zero, "
+        "the bits of actuator_coordinates_jacobian at q (the tracked Newton evaluated it there; "
+        "actuator_jacobian's to round-off). Non-zero, "
         "q and J untouched, when there is no mode.",
         inputs=fk.inputs,
         outputs=(fk.output("q"), jacobian_output(structure, sp.zeros(3, 3))),
