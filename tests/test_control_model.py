@@ -655,6 +655,8 @@ def _evaluate(function: str, motion: Motion, backend: str) -> list[np.ndarray]:
         return [rpr3gen.actuator_coordinates(model, q, backend)]
     if function == "actuator_jacobian":
         return [rpr3gen.actuator_jacobian(model, q, backend)]
+    if function == "actuator_coordinates_jacobian":
+        return list(rpr3gen.actuator_coordinates_jacobian(model, q, backend))
     if function == "jacobian_rate":
         return [rpr3gen.jacobian_rate(model, q, qd, backend)]
     if function == "platform_velocity":
@@ -673,6 +675,7 @@ def _evaluate(function: str, motion: Motion, backend: str) -> list[np.ndarray]:
 FUNCTIONS = (
     "actuator_coordinates",
     "actuator_jacobian",
+    "actuator_coordinates_jacobian",
     "jacobian_rate",
     "platform_velocity",
     "task_space_dynamics",

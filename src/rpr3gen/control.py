@@ -78,6 +78,17 @@ def actuator_jacobian(model: Model, q: ArrayLike, backend: str = "numpy") -> np.
     return J.reshape(-1, 3, 3)
 
 
+@checked(q=Rows(3))
+def actuator_coordinates_jacobian(
+    model: Model, q: ArrayLike, backend: str = "numpy"
+) -> tuple[np.ndarray, np.ndarray]:
+    """``qa`` (n, 3) and ``J = d qa / d q`` (n, 3, 3) of each pose in one evaluation (eqs. 5,
+    6), their common terms computed once: :func:`actuator_coordinates`' and
+    :func:`actuator_jacobian`'s values to round-off."""
+    (qa, J), _ = evaluate(model, "actuator_coordinates_jacobian", (q,), backend)
+    return qa, J.reshape(-1, 3, 3)
+
+
 @checked(q=Rows(3), qd=Rows(3), same_length=[("q", "qd")])
 def jacobian_rate(model: Model, q: ArrayLike, qd: ArrayLike, backend: str = "numpy") -> np.ndarray:
     """``J' q'``, (n, 3): ``qa'' = J q'' + J' q'`` (eq. 9 at zero platform acceleration)."""
