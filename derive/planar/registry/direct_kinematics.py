@@ -260,9 +260,8 @@ def forward_kinematics_jacobian(structure: Structure) -> FunctionSpec:
     :func:`forward_kinematics`' kernel, whose hidden output is that Jacobian: its Newton
     evaluated it at the pose it accepts (by ``actuator_coordinates_jacobian``'s kernels, so the
     bits of ``rpr3_actuator_coordinates_jacobian``), and its fallback evaluates it at the mode
-    it returns. A
-    control tick that needs J right after the pose (the velocity from ``J q' = qa'``, the
-    efforts from ``J^T tau = ...``) saves the second evaluation.
+    it returns. A control tick that needs J right after the pose (the velocity from
+    ``J q' = qa'``, the efforts from ``J^T tau = ...``) saves the second evaluation.
     """
     fk = forward_kinematics(structure)
     return FunctionSpec(
