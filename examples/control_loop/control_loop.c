@@ -11,6 +11,7 @@
  *   q'    : J q' = qa'
  *   M, c  = rpr3_task_space_dynamics(q, q')
  *   tau   : J^T tau = M (qdd_d + Kd (qd_d - q') + Kp (q_d - q)) + c
+ *           (both solves from J's cofactors and 1 / det J, computed once a tick)
  * Prints the tracking error, the pose and velocity estimates' errors, the failed calls and the
  * latency (p50, p99, max) of the forward kinematics, of the rest of the tick (velocity, reference,
  * dynamics, law) and of the whole tick. The ticks alternate between the two measures: an even
@@ -109,12 +110,16 @@ static void reference(const double *amplitude, double t, double *q, double *qd, 
     }
 }
 
-/* Solves A x = b (transpose = 0) or A^T x = b (transpose = 1), A 3x3 row-major, by the
- * cofactors: A^-1 = C^T / det A. Returns -1, x untouched, when A is singular to round-off:
+/* A 3x3 row-major matrix A's cofactors c (A^-1 = c^T / det A) and 1 / det A, computed once for
+ * the tick's two solves (J q' = qa' and J^T tau = f). Returns -1 when A is singular to round-off:
  * |det A| at most 1e-12 times the product of its row norms (compared squared: no sqrt). */
-static int solve3(const double *a, const double *b, int transpose, double *x)
+struct cofactors {
+    double c[9], inv;
+};
+
+static int cofactors3(const double *a, struct cofactors *f)
 {
-    double c[9], det, inv, y0, y1, y2;
+    double *c = f->c, det;
     c[0] = a[4] * a[8] - a[5] * a[7], c[1] = a[5] * a[6] - a[3] * a[8];
     c[2] = a[3] * a[7] - a[4] * a[6], c[3] = a[7] * a[2] - a[8] * a[1];
     c[4] = a[8] * a[0] - a[6] * a[2], c[5] = a[6] * a[1] - a[7] * a[0];
@@ -126,6 +131,15 @@ static int solve3(const double *a, const double *b, int transpose, double *x)
                           * (a[6] * a[6] + a[7] * a[7] + a[8] * a[8]))) {
         return -1;
     }
+    f->inv = 1.0 / det;
+    return 0;
+}
+
+/* Solves A x = b (transpose = 0) or A^T x = b (transpose = 1) from A's cofactors3. */
+static void solve3(const struct cofactors *f, const double *b, int transpose, double *x)
+{
+    const double *c = f->c;
+    double y0, y1, y2;
     if (transpose) { /* A^-T = C / det */
         y0 = c[0] * b[0] + c[1] * b[1] + c[2] * b[2];
         y1 = c[3] * b[0] + c[4] * b[1] + c[5] * b[2];
@@ -135,9 +149,7 @@ static int solve3(const double *a, const double *b, int transpose, double *x)
         y1 = c[1] * b[0] + c[4] * b[1] + c[7] * b[2];
         y2 = c[2] * b[0] + c[5] * b[1] + c[8] * b[2];
     }
-    inv = 1.0 / det;
-    x[0] = y0 * inv, x[1] = y1 * inv, x[2] = y2 * inv;
-    return 0;
+    x[0] = y0 * f->inv, x[1] = y1 * f->inv, x[2] = y2 * f->inv;
 }
 
 /* Plant: one tick of RK4 of the true forward dynamics under the efforts tau, in substeps. */
@@ -228,6 +240,7 @@ static void controller_tick(struct controller *ctl, const long *counts, double t
     const double dt = 1.0 / RATE_HZ;
     const double start = now_ns();
     double qa[3], near[3], q[3], J[9], M[9], c[3], f[3], q_d[3], qd_d[3], qdd_d[3], acc[3];
+    struct cofactors Jc;
     double fk_end = 0.0;
     const int first = !ctl->started;
     int status, i, k;
@@ -256,11 +269,12 @@ static void controller_tick(struct controller *ctl, const long *counts, double t
     memcpy(ctl->q2, first ? q : ctl->q1, sizeof q); /* at first, at rest */
     memcpy(ctl->q1, q, sizeof q);
 
-    if (status != RPR3_OK || solve3(J, ctl->rate, 0, ctl->qd) != 0) { /* the velocity: J q' = qa' */
+    if (status != RPR3_OK || cofactors3(J, &Jc) != 0) {
         ++ctl->failed_jacobian;
         finish(start, fk_end, split, ns);
         return; /* hold the last efforts */
     }
+    solve3(&Jc, ctl->rate, 0, ctl->qd); /* the velocity: J q' = qa' */
 
     reference(ctl->amplitude, t, q_d, qd_d, qdd_d);
     for (k = 0; k < 3; ++k) {
@@ -275,7 +289,7 @@ static void controller_tick(struct controller *ctl, const long *counts, double t
                 f[i] += M[3 * i + k] * acc[k];
             }
         }
-        status = solve3(J, f, 1, ctl->tau);
+        solve3(&Jc, f, 1, ctl->tau);
     }
     if (status != RPR3_OK) {
         ++ctl->failed_dynamics;
