@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 import sympy as sp
@@ -30,10 +32,11 @@ CASES = {
 
 def _run(code: StraightLine, values: dict[sp.Symbol, np.ndarray], n: int) -> np.ndarray:
     rows = {name: f"out[{i}]" for i, (name, _) in enumerate(code.outputs)}
-    lowered = lower_numpy(code, {a: "a", b: "b"}, {k, m}, rows)
+    constants: dict[str, str] = {}
+    lowered = lower_numpy(code, {a: "a", b: "b"}, {k, m}, rows, constants)
     out = np.full((len(code.outputs), n), np.nan)
     scope = {"numpy": np, "out": out, "a": values[a], "b": values[b], "k": values[k],
-             "m": values[m]}  # fmt: skip
+             "m": values[m], **_module_names(lowered, constants)}  # fmt: skip
     work = np.empty((max(lowered.buffers, 1), n))
     for i in range(lowered.buffers):
         scope[f"w{i}"] = work[i]
@@ -52,6 +55,19 @@ def test_each_form_evaluates_like_sympy(name: str) -> None:
         values[a], values[b], values[k], values[m]
     )
     np.testing.assert_allclose(_run(code, values, n)[0], want, rtol=1e-13, atol=1e-13)
+
+
+def _module_names(lowered, constants: dict[str, str]) -> dict[str, object]:
+    """What the module template defines for the lowered lines: the ufuncs by name
+    (``_multiply``) and the number constants as 0-d arrays (``_K0``)."""
+    names: dict[str, object] = {f"_{ufunc}": getattr(np, ufunc) for ufunc in lowered.ufuncs}
+    names.update({name: np.array(eval(text), np.float64) for text, name in constants.items()})
+    return names
+
+
+def _calls(lowered) -> list[str]:
+    """The ufunc of each vector line that is a call (not a scalar operand's 0-d array)."""
+    return [line.split("(")[0] for line in lowered.vector_lines if " = " not in line]
 
 
 def _wrap(x: sp.Expr) -> sp.Expr:
@@ -117,8 +133,7 @@ def test_copies_and_negations_fold_into_their_uses() -> None:
     np.testing.assert_allclose(out[0], values[a] * values[b] - 2.0, rtol=1e-15)
     np.testing.assert_allclose(out[1], -values[a] * values[b], rtol=1e-15)
     lowered = lower_numpy(code, {a: "a", b: "b"}, {k, m}, {"t4": "out[0]", "t3": "out[1]"})
-    calls = [line.split("(")[0] for line in lowered.vector_lines]
-    assert calls == ["numpy.multiply", "numpy.add", "numpy.multiply"]  # t1 - k, then -t1
+    assert _calls(lowered) == ["_multiply", "_add", "_multiply"]  # t1 - k, then -t1
 
 
 def _generated_numpy():
@@ -139,13 +154,15 @@ def test_sin_and_cos_of_one_argument_are_one_sincos_call() -> None:
         ops_after=0,
     )
     rows = {"y": "out[0]", "s": "out[1]"}
-    lowered = lower_numpy(code, {a: "a", b: "b"}, {k, m}, rows)
+    constants: dict[str, str] = {}
+    lowered = lower_numpy(code, {a: "a", b: "b"}, {k, m}, rows, constants)
     assert lowered.sincos
     assert sum("_sincos(" in line for line in lowered.vector_lines) == 1
-    assert not any("numpy.sin(" in line or "numpy.cos(" in line for line in lowered.vector_lines)
+    assert not any(call in ("_sin", "_cos") for call in _calls(lowered))
     out = np.full((2, n), np.nan)
     scope = {"numpy": np, "out": out, "a": values[a], "b": values[b], "k": 2.0, "m": 3.0,
-             "_sincos": _generated_numpy()._sincos}  # fmt: skip
+             "_sincos": _generated_numpy()._sincos,
+             **_module_names(lowered, constants)}  # fmt: skip
     for i in range(lowered.buffers):
         scope[f"w{i}"] = np.empty(n)
     exec("\n".join(lowered.scalar_lines + lowered.vector_lines), scope)
@@ -188,3 +205,47 @@ def test_scratch_rows_passed_in_give_the_same_bits() -> None:
     work = np.full((rows + 3, 80), np.nan)  # larger than needed, and dirty
     module.rpr3_inverse_dynamics(params, traj.q, traj.qd, traj.qdd, reused, work=work)
     assert fresh.tobytes() == reused.tobytes()
+
+
+def test_operands_are_arrays_and_outputs_positional_with_the_scalars_values() -> None:
+    # A call's cheapest form: every operand an array (a number as a module constant, a parameter
+    # expression computed once per call, both 0-d), the output by position. The values are
+    # those of the same calls on Python scalars, bit for bit.
+    rng = np.random.default_rng(7)
+    n = 64
+    values = {a: rng.uniform(-2, 2, n), b: rng.uniform(-2, 2, n), k: 0.7, m: 1.3}
+    expr = (k + m) * a - 3 * b + (k + m) * b**2 - sp.Rational(1, 3) * a * b + k / (a**2 + 1)
+    code = StraightLine(assignments=((t1, expr),), outputs=(("y", t1),), ops_before=0, ops_after=0)
+    constants: dict[str, str] = {}
+    lowered = lower_numpy(code, {a: "a", b: "b"}, {k, m}, {"y": "out[0]"}, constants)
+    hoisted = [line for line in lowered.vector_lines if " = " in line]
+    assert len(hoisted) == len({line.split(" = ", 1)[1] for line in hoisted})  # each once
+    operand = re.compile(r"^(w\d+|out\[\d+\]|a|b|_K\d+|_k\d+)$")
+    for line in lowered.vector_lines:
+        if " = " in line:
+            continue
+        assert "out=" not in line
+        args = line[line.index("(") + 1 : -1].split(", ")
+        assert all(operand.match(arg) for arg in args), line
+
+    def run(as_arrays: bool) -> np.ndarray:
+        out = np.full((1, n), np.nan)
+        scope = {"numpy": np, "out": out, "a": values[a], "b": values[b],
+                 "k": np.float64(values[k]), "m": np.float64(values[m])}  # fmt: skip
+        scope.update({f"_{u}": getattr(np, u) for u in lowered.ufuncs})
+        for text, name in constants.items():
+            scope[name] = np.array(eval(text), np.float64) if as_arrays else eval(text)
+        for i in range(lowered.buffers):
+            scope[f"w{i}"] = np.empty(n)
+        lines = lowered.vector_lines
+        if not as_arrays:  # the hoisted parameter expressions as the scalars they are
+            lines = [line.replace("numpy.array(", "(").replace(", numpy.float64)", ")")
+                     for line in lines]  # fmt: skip
+        exec("\n".join(lowered.scalar_lines + lines), scope)
+        return out[0]
+
+    got, scalars = run(True), run(False)
+    np.testing.assert_array_equal(got.view(np.int64), scalars.view(np.int64))
+    x, y = values[a], values[b]
+    want = 2.0 * x - 3 * y + 2.0 * y**2 - x * y / 3 + 0.7 / (x**2 + 1)
+    np.testing.assert_allclose(got, want, rtol=1e-13, atol=1e-13)

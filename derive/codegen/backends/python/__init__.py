@@ -14,6 +14,9 @@ from rpr3gen_derive.codegen.backends.python.lowering import lower_numpy
 from rpr3gen_derive.codegen.compiled import name_tables, table_count
 from rpr3gen_derive.codegen.spec import ModuleSpec
 
+#: The ufuncs the module's ``_sincos`` helper calls (through the same module-level names).
+SINCOS_UFUNCS = frozenset({"absolute", "add", "cos", "multiply", "rint", "sin", "subtract"})
+
 if TYPE_CHECKING:
     from rpr3gen_derive.codegen.compiled import Compiled, Stage
 
@@ -28,6 +31,7 @@ def render(
     """``{"numpy": (file name, text)}`` of one module."""
 
     functions = []
+    constants: dict[str, str] = {}  # the module's number constants, shared by its functions
     with stage("print"):
         for c in compiled:
             if c.spec.c_body is not None:  # C only: the runtime composes it from the others
@@ -42,7 +46,7 @@ def render(
                     "c": c,
                     "spec": c.spec,
                     "name": f"{module.prefix}_{c.spec.name}",
-                    "lowered": lower_numpy(c.code, inputs, params, rows),
+                    "lowered": lower_numpy(c.code, inputs, params, rows, constants),
                     "first_input": c.spec.inputs[0].name,
                     "sizes": {
                         o.name: table_count(o.table) if o.table else str(o.size)
@@ -58,6 +62,8 @@ def render(
             tables=tables,
             source_hash=digest,
             sincos=any(f["lowered"].sincos for f in functions),
+            ufuncs=sorted(set().union(*(f["lowered"].ufuncs for f in functions)) | SINCOS_UFUNCS),
+            constants=[(name, text) for text, name in constants.items()],
             sin_coefficients=[mathkernels.literal(c) for c in mathkernels.SIN],
             cos_coefficients=[mathkernels.literal(c) for c in mathkernels.COS],
             ops_before=sum(c.code.ops_before for c in compiled),

@@ -1,10 +1,17 @@
 """Lower a straight-line program to NumPy ufunc calls into preallocated buffers.
 
-Each operation becomes one ufunc call with ``out=``, writing into a row of a work array that is
-allocated once per call; a row is reused as soon as the value in it is dead, so the working set
-of a block of samples stays in cache and no temporary array is allocated per operation.
-Subexpressions of parameters only are computed once per call as Python scalars. Outputs that
-are named intermediates are computed straight into their row of ``out``.
+Each operation becomes one ufunc call with its output given, writing into a row of a work array
+that is allocated once per call; a row is reused as soon as the value in it is dead, so the
+working set of a block of samples stays in cache and no temporary array is allocated per
+operation. Subexpressions of parameters only are computed once per call as Python scalars.
+Outputs that are named intermediates are computed straight into their row of ``out``.
+
+A call's fixed cost is most of a small block's time, so each call is the cheapest form of the
+same operation (the same values, bit for bit): the ufunc through a module-level name
+(``_multiply = numpy.multiply``), its output passed by position, and a scalar operand as a
+0-d array (a Python or NumPy scalar is converted to one at every call, ~0.3 us): the module's
+number constants once at import (:attr:`_Lowering.constants`), a function's parameter
+expressions once per call, at the head of its body.
 
 Every ufunc call costs a pass over the block and a fixed ~0.3 us of dispatch, so the lowering
 first folds away the assignments that are only a copy or a negation of another value
@@ -34,6 +41,7 @@ class LoweredNumpy:
     vector_lines: list[str]
     buffers: int
     sincos: bool = False
+    ufuncs: frozenset[str] = frozenset()
 
 
 #: Work rows the module's ``_sincos(x, s, c, work)`` helper takes.
@@ -67,6 +75,11 @@ class _Lowering:
     """
 
     scalars: set[sp.Symbol]
+    #: The module's number constants, shared by its functions: text -> name (``_K0`` ...).
+    constants: dict[str, str] = field(default_factory=dict)
+    #: This function's scalar operands of parameters: text -> name (``_k0`` ...).
+    hoisted: dict[str, str] = field(default_factory=dict)
+    ufuncs: set[str] = field(default_factory=set)
     location: dict[sp.Symbol, str] = field(default_factory=dict)
     free: list[int] = field(default_factory=list)
     temps: set[str] = field(default_factory=set)
@@ -116,13 +129,27 @@ class _Lowering:
         for a in args:
             self.release(a)
         target = dest or self.new()
-        self.lines.append(f"numpy.{ufunc}({', '.join(args)}, out={target})")
+        self.line(ufunc, args, target)
         return target
+
+    def line(self, ufunc: str, args: list[str], target: str) -> None:
+        """``_ufunc(*args, target)``: the call, its output by position."""
+        self.ufuncs.add(ufunc)
+        self.lines.append(f"_{ufunc}({', '.join(args)}, {target})")
 
     # -- expressions -------------------------------------------------------------------------
 
     def scalar(self, expr: sp.Expr) -> str:
-        return f"({numpy_code(expr)})"
+        """The name of a scalar operand's 0-d array: a module constant for a number, else one
+        computed at the head of the function."""
+        text = numpy_code(expr)
+        if expr.is_Number:
+            return self.constants.setdefault(text, f"_K{len(self.constants)}")
+        return self.hoisted.setdefault(text, f"_k{len(self.hoisted)}")
+
+    def constant(self, value: str) -> str:
+        """The module constant of a number's text (``TWO_PI`` ...)."""
+        return self.constants.setdefault(value, f"_K{len(self.constants)}")
 
     def emit(self, expr: sp.Expr, dest: str | None = None) -> str:
         """Operand text of ``expr``; written into ``dest`` when one is given."""
@@ -147,9 +174,9 @@ class _Lowering:
         if expr.func is wrap_angle:  # x - 2 pi rint(x / 2 pi)
             x = self.emit(expr.args[0])
             turns = self.new()
-            self.lines.append(f"numpy.multiply({x}, {INV_TWO_PI}, out={turns})")
-            self.lines.append(f"numpy.rint({turns}, out={turns})")
-            self.lines.append(f"numpy.multiply({turns}, {TWO_PI}, out={turns})")
+            self.line("multiply", [x, self.constant(INV_TWO_PI)], turns)
+            self.line("rint", [turns], turns)
+            self.line("multiply", [turns, self.constant(TWO_PI)], turns)
             return self.call("subtract", [x, turns], dest)
         if expr.func in (sp.Min, sp.Max):  # n-ary: folded pairwise
             ufunc = "fmin" if expr.func is sp.Min else "fmax"
@@ -202,7 +229,7 @@ class _Lowering:
         steps: list[tuple[str, str]] = [("multiply", self.emit(f)) for f in numerator[1:]]
         coefficient = self.scalar(sp.Mul(*scalar)) if scalar else None
         if not numerator:  # c / x
-            acc_text = coefficient or "1.0"
+            acc_text = coefficient or self.constant("1.0")
             divisor = self._product(denominator)
             return self.call("divide", [acc_text, divisor], dest)
         acc = factors[0]
@@ -233,15 +260,15 @@ class _Lowering:
             b = self.emit(base)
             self.release(b)
             target = dest or self.new()
-            self.lines.append(f"numpy.multiply({b}, {b}, out={target})")
+            self.line("multiply", [b, b], target)
             return target
         if exponent == -1:
-            return self.call("divide", ["1.0", self.emit(base)], dest)
+            return self.call("divide", [self.constant("1.0"), self.emit(base)], dest)
         if exponent == sp.Rational(1, 2):
             return self.call("sqrt", [self.emit(base)], dest)
         if exponent == sp.Rational(-1, 2):
             root = self.call("sqrt", [self.emit(base)], None)
-            return self.call("divide", ["1.0", root], dest)
+            return self.call("divide", [self.constant("1.0"), root], dest)
         if exponent.is_Integer and exponent > 2:
             acc = self.emit(base)
             b = acc
@@ -282,8 +309,12 @@ def lower_numpy(
     inputs: dict[sp.Symbol, str],
     params: set[sp.Symbol],
     output_rows: dict[str, str],
+    constants: dict[str, str] | None = None,
 ) -> LoweredNumpy:
-    """Lower ``code`` given where inputs live (``{x: "x"}``) and each output's row text."""
+    """Lower ``code`` given where inputs live (``{x: "x"}``) and each output's row text.
+
+    ``constants``: the module's number constants so far (text -> name), added to in place, so
+    that the module's functions share them."""
     statements, outputs = fold_copies(code, params)
     # Output rows: an output that is a named intermediate is computed in place.
     alias: dict[sp.Symbol, str] = {}
@@ -297,7 +328,7 @@ def lower_numpy(
     for _, expr in outputs:  # read by an output: alive to the end
         for sym in expr.free_symbols:
             uses[sym] = len(statements)
-    state = _Lowering(scalars=set(params))
+    state = _Lowering(scalars=set(params), constants={} if constants is None else constants)
     state.location.update(inputs)
     scalar_lines: list[str] = []
     rhs_of = dict(statements)
@@ -338,4 +369,8 @@ def lower_numpy(
         if expr.is_Symbol and alias.get(expr) == row and expr not in state.scalars:
             continue
         state.emit(expr, row)
-    return LoweredNumpy(scalar_lines, state.lines, state.count, bool(pairs))
+    hoisted = [f"{name} = numpy.array({text}, numpy.float64)"
+               for text, name in state.hoisted.items()]  # fmt: skip
+    return LoweredNumpy(
+        scalar_lines, hoisted + state.lines, state.count, bool(pairs), frozenset(state.ufuncs)
+    )
