@@ -68,6 +68,15 @@ EXTRA_FLAGS: tuple[tuple[str, ...], ...] = (
     ("-march=native", "-fno-tree-slp-vectorize", "-falign-functions=64"),
     (),
 )
+#: Tried first, with the first set of EXTRA_FLAGS: link-time optimisation in partitions
+#: compiled side by side (``-flto=auto``: as many jobs as cores). One translation unit
+#: otherwise compiles on one core, and gcc's register allocation of the large kernels is most
+#: of a build (issue 20: rrr_1's library 17.7 -> 10.7 s, the paper's 10.6 -> 6.8 s and
+#: 11.3 -> 6.3 s on 2 cores). Every function keeps its code's speed (the generated functions
+#: through the library measured the same within 2.5 %, docs/performance.md) and its values:
+#: no flag that changes one is added. A compiler or linker that refuses it builds with
+#: EXTRA_FLAGS alone.
+PARALLEL_FLAGS: tuple[str, ...] = ("-flto=auto", "-flto-partition=balanced")
 LIBS: tuple[str, ...] = ("-lm",)
 
 
@@ -159,7 +168,7 @@ def _build(variant: Variant, command: list[str], files: dict[str, bytes], target
         for name, text in files.items():
             (Path(tmp) / name).write_bytes(text)
         built = Path(tmp) / target.name
-        for extra in EXTRA_FLAGS:
+        for extra in ((*EXTRA_FLAGS[0], *PARALLEL_FLAGS), *EXTRA_FLAGS):
             result = subprocess.run(
                 [*command, *CFLAGS, *extra, variant.files["c_source"], "shim.c", "-o",
                  built.name, *LIBS],
