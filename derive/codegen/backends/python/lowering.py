@@ -144,11 +144,11 @@ class _Lowering:
         computed at the head of the function."""
         text = numpy_code(expr)
         if expr.is_Number:
-            return self.constants.setdefault(text, f"_K{len(self.constants)}")
+            return self.constant(text)
         return self.hoisted.setdefault(text, f"_k{len(self.hoisted)}")
 
     def constant(self, value: str) -> str:
-        """The module constant of a number's text (``TWO_PI`` ...)."""
+        """The module constant of a number's text (``"1.0"``, ``TWO_PI`` ...)."""
         return self.constants.setdefault(value, f"_K{len(self.constants)}")
 
     def emit(self, expr: sp.Expr, dest: str | None = None) -> str:
