@@ -214,3 +214,42 @@ def test_numpy_and_c_agree_on_every_return_code(actuation: str) -> None:
             ev.q[:], ev.qd[:], ev.qdd[:] = q[i], zero[i], zero[i]
             single.append(ev())
         assert single == expected, backend
+
+
+@pytest.mark.parametrize("actuation", ACTUATIONS)
+def test_the_codes_short_cut_gives_the_per_sample_codes(
+    actuation: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # failures.return_codes first asks whether any sample failed (one reduction per array) and
+    # computes the per-sample codes only then: every kind of failure, alone in its block, must
+    # reach them, and give what the per-sample pass alone gives.
+    from rpr3gen import failures
+
+    model = _model(actuation)
+    variant = manifest.load(actuation)
+    info = variant.function("inverse_dynamics")
+    p = model.params
+    ok = np.array([0.01, -0.02, 0.1])
+    cases = {
+        "none": (ok, 0.0, None),
+        "an input not finite": (ok, np.inf, variant.return_codes["NOT_FINITE"]),
+        "a leg of zero length": (
+            np.array([p["xB1"] - p["xB3"], p["yB1"] - p["yB3"], 0.0]), 0.0,
+            variant.return_codes["SINGULAR"],
+        ),
+        "an output overflowing": (ok, 1e308, variant.return_codes["SINGULAR"]),
+    }  # fmt: skip
+    for name, (pose, acceleration, code) in cases.items():
+        q = np.tile(ok, (6, 1))
+        qdd = np.zeros_like(q)
+        q[4], qdd[4] = pose, acceleration
+        ev = evaluator(variant, "numpy")
+        outs = ev.allocate(info, len(q))
+        ins = [q, np.zeros_like(q), qdd]
+        ev.run(info, model.vector(variant.param_names), ins, outs)
+        got = failures.return_codes(info, ins, outs)
+        with monkeypatch.context() as patch:
+            patch.setattr(failures, "_none_failed", lambda *args: False)
+            per_sample = failures.return_codes(info, ins, outs)
+        assert got.tolist() == per_sample.tolist(), name
+        assert got.tolist() == [0] * 4 + [code or 0] + [0], name
