@@ -175,6 +175,26 @@ def test_generated_c_compiles_without_warnings(
     assert result.stderr == ""
 
 
+@pytest.mark.parametrize("actuation", ACTUATIONS)
+def test_generated_c_compiles_without_its_scheduling_attribute(
+    actuation: str, repo_root: Path
+) -> None:
+    # RPR3_SCHEDULED defined empty (a user's opt-out, and what other compilers get): the same
+    # source, no warning. That the scheduled kernels give the batch's bits is
+    # test_every_function_single_and_batch_agree_bit_for_bit's.
+    cc = shutil.which("cc") or shutil.which("gcc")
+    assert cc, "a C compiler is required by the test suite"
+    source = repo_root / "generated" / actuation / "rpr3.c"
+    assert source.read_text().count("\nRPR3_SCHEDULED\nstatic ") >= 10
+    result = subprocess.run(
+        [cc, "-std=c99", "-Wall", "-Wextra", "-pedantic", "-Werror", "-fsyntax-only",
+         "-DRPR3_SCHEDULED=", str(source)],
+        capture_output=True, text=True, check=False,
+    )  # fmt: skip
+    assert result.returncode == 0, result.stderr
+    assert result.stderr == ""
+
+
 def test_generated_c_needs_only_math_and_stddef(repo_root: Path) -> None:
     for path in sorted((repo_root / "generated").rglob("rpr3.[ch]")):
         includes = {
