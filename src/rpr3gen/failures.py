@@ -15,7 +15,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from rpr3gen.manifest import FunctionInfo
+from rpr3gen.manifest import CheckInfo, FunctionInfo
 
 __all__ = ["apply", "finite_rows", "return_codes"]
 
@@ -31,6 +31,25 @@ def finite_rows(array: np.ndarray) -> np.ndarray:
     return np.isfinite(array.T).all(axis=0)
 
 
+def _tested(
+    check: CheckInfo,
+    function: FunctionInfo,
+    inputs: Sequence[np.ndarray],
+    outputs: Sequence[np.ndarray],
+) -> list[np.ndarray] | np.ndarray | None:
+    """What ``check`` tests: the arrays that must be finite (a list), the (n,) values that must
+    not be below its threshold (an array), or None (a custom check: the C applies it)."""
+    if check.kind == "inputs_not_finite":
+        return list(inputs)
+    if check.kind == "custom":
+        return None
+    if check.kind == "below":
+        assert check.output is not None
+        assert check.component is not None
+        return outputs[check.output][:, check.component]
+    return [o for o, i in zip(outputs, function.outputs, strict=True) if not i.hidden]
+
+
 def _none_failed(
     function: FunctionInfo, inputs: Sequence[np.ndarray], outputs: Sequence[np.ndarray]
 ) -> bool:
@@ -38,19 +57,11 @@ def _none_failed(
     one reduction per array, where the per-sample codes cost a dozen more passes."""
     with np.errstate(invalid="ignore"):
         for check in function.checks:
-            if check.kind == "inputs_not_finite":
-                arrays = inputs
-            elif check.kind == "custom":
-                continue
-            elif check.kind == "below":
-                assert check.output is not None
-                value = outputs[check.output][:, check.component]
-                if not (value >= check.threshold).all():
+            tested = _tested(check, function, inputs, outputs)
+            if isinstance(tested, list):
+                if not all(np.isfinite(a).all() for a in tested):
                     return False
-                continue
-            else:
-                arrays = [o for o, i in zip(outputs, function.outputs, strict=True) if not i.hidden]
-            if not all(np.isfinite(a).all() for a in arrays):
+            elif tested is not None and not (tested >= check.threshold).all():
                 return False
     return True
 
@@ -95,18 +106,13 @@ def return_codes(
         return codes
     with np.errstate(invalid="ignore"):
         for check in function.checks:
-            if check.kind == "inputs_not_finite":
-                failed = ~np.all([finite_rows(a) for a in inputs], axis=0)
-            elif check.kind == "custom":  # C only, applied there
+            tested = _tested(check, function, inputs, outputs)
+            if tested is None:  # C only, applied there
                 continue
-            elif check.kind == "below":
-                assert check.output is not None
-                assert check.component is not None
-                value = outputs[check.output][:, check.component]
-                failed = ~(value >= check.threshold)
+            if isinstance(tested, list):
+                failed = ~np.all([finite_rows(a) for a in tested], axis=0)
             else:
-                public = [o for o, i in zip(outputs, function.outputs, strict=True) if not i.hidden]
-                failed = ~np.all([finite_rows(a) for a in public], axis=0)
+                failed = ~(tested >= check.threshold)
             hit = failed & pending
             codes[hit] = check.code
             pending &= ~hit
