@@ -55,14 +55,18 @@ def render(
                 }
             )
     tables = name_tables(module, compiled)
+    sincos = any(f["lowered"].sincos for f in functions)
+    ufuncs = set().union(*(f["lowered"].ufuncs for f in functions))
+    if sincos:  # _sincos calls its ufuncs by the same names
+        ufuncs |= SINCOS_UFUNCS
     with stage("render"):
         text = env.get_template("backends/python/templates/module.py.jinja").render(
             module=module,
             functions=functions,
             tables=tables,
             source_hash=digest,
-            sincos=any(f["lowered"].sincos for f in functions),
-            ufuncs=sorted(set().union(*(f["lowered"].ufuncs for f in functions)) | SINCOS_UFUNCS),
+            sincos=sincos,
+            ufuncs=sorted(ufuncs),
             constants=[(name, text) for text, name in constants.items()],
             sin_coefficients=[mathkernels.literal(c) for c in mathkernels.SIN],
             cos_coefficients=[mathkernels.literal(c) for c in mathkernels.COS],
