@@ -125,3 +125,25 @@ def test_estrin_is_the_polynomial() -> None:
             scope = {"z": z, **{f"z{p}": z**p for p in mathkernels.powers(len(coefficients))}}
             want = sum(c * z**k for k, c in enumerate(coefficients))
             assert eval(text, scope) == pytest.approx(want, rel=1e-14, abs=1e-300)
+
+
+def test_the_reduction_constants_are_pi_over_2_in_exact_parts() -> None:
+    """The Cody-Waite parts that the C kernel and the NumPy ``_sincos`` share: the first three
+    have at most 33 significant bits (so n times each is exact for |n| < 2^20), each is pi/2's
+    next piece (under an ulp of what is left), and the four sum to pi/2 within 2^-155; 2/pi is
+    the nearest double."""
+    from rpr3gen_derive.codegen import mathkernels
+
+    parts = [float.fromhex(h) for h in mathkernels.PI_OVER_2_PARTS]
+    with mpmath.workdps(80):
+        left = mpmath.pi / 2
+        for k, part in enumerate(parts):
+            mantissa, _ = mpmath.mpf(part).man_exp
+            if k < 3:
+                assert int(abs(mantissa)).bit_length() <= 33, k
+            assert abs(left - part) < abs(part) * 2.0**-32, k  # the next 33 bits, or the rest
+            left -= part
+        assert abs(left) < 2.0**-155
+        assert float(mathkernels.TWO_OVER_PI) == float(2 / mpmath.pi)
+    for part in parts[:3]:  # n * part is exact for |n| < 2^20: the product rounds to itself
+        assert float(mpmath.mpf(2**20 - 1) * part) == (2**20 - 1) * part

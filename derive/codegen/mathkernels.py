@@ -66,6 +66,17 @@ ATAN = (
     0.03806214555561284,
     -0.017905045528408655,
 )
+#: 2/pi, rounded: x 2/pi gives the fast reduction's n.
+TWO_OVER_PI = "0.6366197723675814"
+#: pi/2 in the fast reduction's four parts (hex, exact): three of 33 bits, so that n times each
+#: is exact for |n| < 2^20, and the rest rounded to double. The C kernel and the NumPy module's
+#: ``_sincos`` both read them from here.
+PI_OVER_2_PARTS = (
+    "0x1.921fb544p+0",
+    "0x1.0b4611a6p-34",
+    "0x1.3198a2ep-69",
+    "0x1.b839a252049c1p-104",
+)
 #: The fast reduction's range: |x| < 2^20, so that n |x| 2/pi| < 2^20 and n * (33-bit part) is
 #: exact.
 FAST_LIMIT = "0x1p20"
@@ -159,6 +170,8 @@ def context(kernels: set[str]) -> dict[str, Any]:
         "atan_poly": estrin(ATAN, "z"),
         "atan_powers": powers(len(ATAN)),
         "fast_limit": FAST_LIMIT,
+        "two_over_pi": TWO_OVER_PI,
+        "pi_over_2": PI_OVER_2_PARTS,
         "table": [f"{c}.0" for c in two_over_pi_chunks()],
         "table_size": TABLE_SIZE,
     }

@@ -70,6 +70,8 @@ def render(
             constants=[(name, text) for text, name in constants.items()],
             sin_coefficients=[mathkernels.literal(c) for c in mathkernels.SIN],
             cos_coefficients=[mathkernels.literal(c) for c in mathkernels.COS],
+            two_over_pi=mathkernels.TWO_OVER_PI,
+            pi_over_2=[mathkernels.literal(float.fromhex(h)) for h in mathkernels.PI_OVER_2_PARTS],
             ops_before=sum(c.code.ops_before for c in compiled),
             ops_after=sum(c.code.ops_after for c in compiled),
             assignments=sum(len(c.code.assignments) for c in compiled),
