@@ -123,10 +123,14 @@ def matrix_output(
     units: tuple[str, ...],
     meaning: str,
     entry: Callable[[int, int], str] = lambda i, j: "",
+    *,
+    output: str | None = None,
+    hidden: bool = False,
 ) -> Output:
-    """A 3 x 3 matrix output, row-major; ``units`` per column (3) or per entry (9)."""
+    """A 3 x 3 matrix output, row-major, components ``{name}11`` ... ``{name}33``; ``units`` per
+    column (3) or per entry (9); ``output``: the output's name when it is not ``name``."""
     return Output(
-        name,
+        output or name,
         tuple(m[i, j] for i in range(3) for j in range(3)),
         tuple(
             Component(
@@ -138,6 +142,7 @@ def matrix_output(
             for j in range(3)
         ),
         meaning,
+        hidden=hidden,
     )
 
 

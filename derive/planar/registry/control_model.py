@@ -40,19 +40,23 @@ def actuator_coordinates(structure: Structure) -> FunctionSpec:
     )
 
 
-def jacobian_output(structure: Structure, J: sp.Matrix, name: str = "J", **kw: bool) -> Output:
+def jacobian_output(
+    structure: Structure, J: sp.Matrix, name: str = "J", hidden: bool = False
+) -> Output:
     """The output ``J = d qa / d q`` (row-major, components ``J11`` ... ``J33``) of the matrix
-    ``J``: :func:`actuator_jacobian`'s, and the forward kinematics' (``kw``: ``hidden``)."""
+    ``J``: :func:`actuator_jacobian`'s, and the forward kinematics' (named ``jacobian``,
+    hidden)."""
     units = ("1/m", "1/m", "1") if structure.actuated_kind == "R" else ("1", "1", "m")
     qa_names = [c.name for c in actuator_argument(structure).components]
-    out = matrix_output(
+    return matrix_output(
         "J",
         J,
         units,
         "J = d qa / d q, row-major",
         lambda i, j: f"d {qa_names[i]} / d {POSE.components[j].name}",
+        output=name,
+        hidden=hidden,
     )
-    return Output(name, out.exprs, out.components, out.doc, **kw)
 
 
 def actuator_jacobian(structure: Structure) -> FunctionSpec:
