@@ -6,6 +6,7 @@ built here."""
 from __future__ import annotations
 
 import importlib
+import itertools
 import sys
 from pathlib import Path
 from types import ModuleType
@@ -186,3 +187,14 @@ def test_the_run_with_the_lowest_tick_p50_is_kept_with_every_run(examples: Modul
     assert best["whole tick"]["p50"] == 461.0
     assert best["forward kinematics"]["p50"] == 251.0  # that run's, not the lowest of each
     assert best["runs"] == [601.0, 461.0, 531.0]
+
+
+def test_the_runs_go_round_the_cases(examples: ModuleType) -> None:
+    """Each case runs ``runs`` times, and between two runs of one case every other case runs
+    once, so that a slow spell of the shared machine spoils at most one run of each."""
+    cases = [("prismatic", "rectilinear"), ("prismatic", "rotation"), ("revolute", "rotation")]
+    order = examples.rounds(cases, 3)
+    for case in cases:
+        at = [k for k, c in enumerate(order) if c == case]
+        assert len(at) == 3
+        assert all(b - a == len(cases) for a, b in itertools.pairwise(at))

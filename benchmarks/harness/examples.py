@@ -10,7 +10,10 @@ The C program runs :data:`RUNS` times per variant and trajectory, and the run wi
 tick p50 is kept, with every run's p50 beside it (``"runs"``): on this shared machine the same
 binary's tick p50 moved between 461 and 691 ns in runs seconds apart (2026-11-27), so one run
 measures the neighbours as much as the code; the best of several is what the rest of the
-benchmark takes too (the best of the repeats).
+benchmark takes too (the best of the repeats). The runs go round the four cases in turn
+(:func:`rounds`), as ``c/functions.c`` goes round the functions: a case's runs spread over the
+minute the examples take, where back to back they could all fall in one slow spell (one full
+run of 2026-11-27 had all five of one case at 732-761 ns and all five of another at 351).
 """
 
 from __future__ import annotations
@@ -50,6 +53,11 @@ def best_run(reports: list[dict[str, dict[str, float]]]) -> dict[str, Any]:
     return {**best, "runs": [found["whole tick"]["p50"] for found in reports]}
 
 
+def rounds(cases: list[tuple[str, str]], runs: int) -> list[tuple[str, str]]:
+    """The order the C program runs ``cases``: each once, ``runs`` times over."""
+    return [case for _ in range(runs) for case in cases]
+
+
 def run(runs: int = RUNS) -> dict[str, Any]:
     """Latencies by language, variant and trajectory, with the C build's flags; the C program
     run ``runs`` times (:func:`best_run`)."""
@@ -66,22 +74,20 @@ def run(runs: int = RUNS) -> dict[str, Any]:
         params = subprocess.run([sys.executable, "-m", "rpr3gen.cli", "params"],
                                 capture_output=True, text=True, check=True)  # fmt: skip
         (work / "paper.params").write_text(params.stdout)
-        for variant in samples.paper_variants():
-            binary = work / f"control_loop_{variant}"
-            for trajectory in TRAJECTORIES:
-                key = f"{variant}/{trajectory}"
-                if binary.exists():
-                    reports = []
-                    for _ in range(runs):
-                        done = subprocess.run(
-                            [str(binary), trajectory], cwd=work, capture_output=True, text=True,
-                            check=True,
-                        )  # fmt: skip
-                        reports.append(parse(done.stdout))
-                    results["c"][key] = best_run(reports)
-                done = subprocess.run(
-                    [sys.executable, str(EXAMPLE / "control_loop.py"), "--actuation", variant,
-                     trajectory], cwd=work, capture_output=True, text=True, check=True,
-                )  # fmt: skip
-                results["python"][key] = parse(done.stdout)
+        cases = [(v, t) for v in samples.paper_variants() for t in TRAJECTORIES]
+        reports: dict[tuple[str, str], list[dict[str, dict[str, float]]]] = {c: [] for c in cases}
+        built = [(v, t) for v, t in cases if (work / f"control_loop_{v}").exists()]
+        for variant, trajectory in rounds(built, runs):
+            done = subprocess.run([str(work / f"control_loop_{variant}"), trajectory], cwd=work,
+                                  capture_output=True, text=True, check=True)  # fmt: skip
+            reports[variant, trajectory].append(parse(done.stdout))
+        for variant, trajectory in cases:
+            key = f"{variant}/{trajectory}"
+            if reports[variant, trajectory]:
+                results["c"][key] = best_run(reports[variant, trajectory])
+            done = subprocess.run(
+                [sys.executable, str(EXAMPLE / "control_loop.py"), "--actuation", variant,
+                 trajectory], cwd=work, capture_output=True, text=True, check=True,
+            )  # fmt: skip
+            results["python"][key] = parse(done.stdout)
     return results
