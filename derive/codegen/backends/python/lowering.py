@@ -271,15 +271,14 @@ class _Lowering:
             return self.call("divide", [self.constant("1.0"), root], dest)
         if exponent.is_Integer and exponent > 2:
             b = self.emit(base)
-            held = b in self.temps  # read by every product: freed after the last
+            held = b in self.temps  # read by every product: its row is freed after the last
             self.temps.discard(b)
             acc = b
             for k in range(int(exponent) - 1):
                 final = k == int(exponent) - 2
                 acc = self.call("multiply", [acc, b], dest if final else None)
             if held:
-                self.temps.add(b)
-                self.release(b)
+                self.free.append(int(b[1:]))
             return acc
         if exponent.is_Integer and exponent < 0:  # 1/(x*x): numpy.power costs ~15 ns a value
             return self.call("divide", [self.constant("1.0"), self.emit(base**-exponent)],
