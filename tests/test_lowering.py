@@ -148,6 +148,41 @@ def test_copies_and_negations_fold_into_their_uses() -> None:
     assert _calls(lowered) == ["_multiply", "_add", "_multiply"]  # t1 - k, then -t1
 
 
+def test_a_negated_value_is_named_by_its_opposite_when_that_saves_calls() -> None:
+    # t1 = -(a b) costs a product and a sign change; its uses absorb the sign for free
+    # (t2 = b + t1 is b - a b; the output -t1 is a b, computed in its row): flipped, the
+    # program saves the sign change and the output's. t3 = atan2(t1, a) is no sum or product:
+    # a value read there keeps its sign (atan2(-y, x) and -atan2(y, x) differ on the cut).
+    rng = np.random.default_rng(8)
+    n = 64
+    values = {a: rng.uniform(-1, 1, n), b: rng.uniform(-1, 1, n), k: 2.0, m: 3.0}
+    values[a][:4] = 0.0  # products of zero: the signs of zeros hold too
+    t4 = sp.Symbol("t4", real=True)
+    flipped = StraightLine(
+        assignments=((t1, -a * b), (t2, b + t1 * k)),
+        outputs=(("minus t1", -t1), ("t2", t2)),
+        ops_before=0,
+        ops_after=0,
+    )
+    rows = {"minus t1": "out[0]", "t2": "out[1]"}
+    lowered = lower_numpy(flipped, {a: "a", b: "b"}, {k, m}, rows, {})
+    assert _calls(lowered) == ["_multiply", "_multiply", "_subtract"], lowered.vector_lines
+    out = _run(flipped, values, n)
+    ab = values[a] * values[b]
+    np.testing.assert_array_equal(out[0], ab)
+    np.testing.assert_array_equal(out[1], values[b] - ab * 2.0)
+    kept = StraightLine(
+        assignments=((t1, -a * b), (t3, sp.atan2(t1, b)), (t4, t3 + t1)),
+        outputs=(("t4", t4),),
+        ops_before=0,
+        ops_after=0,
+    )
+    lowered = lower_numpy(kept, {a: "a", b: "b"}, {k, m}, {"t4": "out[0]"}, {})
+    assert "arctan2" in lowered.ufuncs
+    want = np.arctan2(-ab, values[b]) + -ab
+    np.testing.assert_array_equal(_run(kept, values, n)[0], want)
+
+
 def _generated_numpy():
     from rpr3gen import manifest
     from rpr3gen.evaluators import numpy_module
