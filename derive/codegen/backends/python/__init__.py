@@ -16,6 +16,9 @@ from rpr3gen_derive.codegen.spec import ModuleSpec
 
 #: The ufuncs the module's ``_sincos`` helper calls (through the same module-level names).
 SINCOS_UFUNCS = frozenset({"absolute", "add", "cos", "multiply", "rint", "sin", "subtract"})
+#: The ufuncs the module's ``_atan2`` helper calls.
+ATAN2_UFUNCS = frozenset({"add", "arctan", "arctan2", "copysign", "divide", "isnan", "multiply",
+                          "signbit"})  # fmt: skip
 
 if TYPE_CHECKING:
     from rpr3gen_derive.codegen.compiled import Compiled, Stage
@@ -59,6 +62,9 @@ def render(
     ufuncs = set().union(*(f["lowered"].ufuncs for f in functions))
     if sincos:  # _sincos calls its ufuncs by the same names
         ufuncs |= SINCOS_UFUNCS
+    atan2 = any(f["lowered"].atan2 for f in functions)
+    if atan2:
+        ufuncs |= ATAN2_UFUNCS
     with stage("render"):
         text = env.get_template("backends/python/templates/module.py.jinja").render(
             module=module,
@@ -66,6 +72,7 @@ def render(
             tables=tables,
             source_hash=digest,
             sincos=sincos,
+            atan2=atan2,
             ufuncs=sorted(ufuncs),
             constants=[(name, text) for text, name in constants.items()],
             sin_coefficients=[mathkernels.literal(c) for c in mathkernels.SIN],

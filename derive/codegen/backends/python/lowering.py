@@ -19,7 +19,9 @@ first folds away the assignments that are only a copy or a negation of another v
 ``-x1 - c`` into ``L - c``, one call instead of three. The C code keeps them (its compiler
 folds them). Then a value whose own sign costs a call (``t = -(a b)``) is named by its opposite
 where its uses take the sign for free (:func:`fold_signs`): 3-4 % fewer calls in the inverse
-dynamics.
+dynamics. ``atan2`` is the module's ``_atan2`` (``numpy.arctan`` of the quotient and the
+quadrant's multiple of pi: ~12 ns a value where ``numpy.arctan2`` costs ~20), ``sin`` and ``cos``
+of one argument its ``_sincos``.
 """
 
 from __future__ import annotations
@@ -31,23 +33,26 @@ from rpr3gen_derive.codegen.backends.python.printer import numpy_code
 from rpr3gen_derive.codegen.cse import StraightLine
 from rpr3gen_derive.codegen.functions import INV_TWO_PI, TWO_PI, wrap_angle
 
-_UFUNC = {sp.cos: "cos", sp.sin: "sin", sp.Abs: "absolute", sp.atan2: "arctan2"}
+_UFUNC = {sp.cos: "cos", sp.sin: "sin", sp.Abs: "absolute"}
 
 
 @dataclass
 class LoweredNumpy:
     """Lines of the generated function body, the size of its work array, and whether it calls
-    the module's ``_sincos`` helper."""
+    the module's ``_sincos`` and ``_atan2`` helpers."""
 
     scalar_lines: list[str]
     vector_lines: list[str]
     buffers: int
     sincos: bool = False
     ufuncs: frozenset[str] = frozenset()
+    atan2: bool = False
 
 
 #: Work rows the module's ``_sincos(x, s, c, work)`` helper takes.
 SINCOS_WORK = 4
+#: Work rows the module's ``_atan2(y, x, out, work)`` helper takes.
+ATAN2_WORK = 1
 
 
 def trig_pairs(statements: list[tuple[sp.Symbol, sp.Expr]]) -> dict[sp.Symbol, sp.Symbol]:
@@ -82,6 +87,7 @@ class _Lowering:
     #: This function's scalar operands of parameters: text -> name (``_k0`` ...).
     hoisted: dict[str, str] = field(default_factory=dict)
     ufuncs: set[str] = field(default_factory=set)
+    atan2: bool = False
     location: dict[sp.Symbol, str] = field(default_factory=dict)
     free: list[int] = field(default_factory=list)
     temps: set[str] = field(default_factory=set)
@@ -187,10 +193,28 @@ class _Lowering:
                 final = k == len(expr.args) - 2
                 acc = self.call(ufunc, [acc, self.emit(arg)], dest if final else None)
             return acc
+        if expr.func is sp.atan2:
+            return self.arctangent(expr, dest)
         if expr.func in _UFUNC:
             args = [self.emit(a) for a in expr.args]
             return self.call(_UFUNC[expr.func], args, dest)
         raise NotImplementedError(f"cannot lower {expr.func.__name__}: {expr}")
+
+    def arctangent(self, expr: sp.Expr, dest: str | None) -> str:
+        """``atan2(y, x)`` by the module's ``_atan2``, which reads ``y`` and ``x`` after writing
+        its output: a row of their own until it returns."""
+        operands = [self.emit(a) for a in expr.args]
+        held = list(dict.fromkeys(a for a in operands if a in self.temps))
+        self.temps.difference_update(held)
+        target = dest or self.new()
+        work = [self.new() for _ in range(ATAN2_WORK)]
+        self.lines.append(f"_atan2({operands[0]}, {operands[1]}, {target}, ({', '.join(work)},))")
+        self.atan2 = True
+        for row in held:
+            self.free.append(int(row[1:]))
+        for row in work:
+            self.release(row)
+        return target
 
     def add(self, expr: sp.Expr, dest: str | None) -> str:
         scalar = [a for a in expr.args if self.is_scalar(a)]
@@ -476,5 +500,10 @@ def lower_numpy(
     hoisted = [f"{name} = numpy.array({text}, numpy.float64)"
                for text, name in state.hoisted.items()]  # fmt: skip
     return LoweredNumpy(
-        scalar_lines, hoisted + state.lines, state.count, bool(pairs), frozenset(state.ufuncs)
+        scalar_lines,
+        hoisted + state.lines,
+        state.count,
+        bool(pairs),
+        frozenset(state.ufuncs),
+        state.atan2,
     )
