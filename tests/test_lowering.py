@@ -153,8 +153,8 @@ def test_copies_and_negations_fold_into_their_uses() -> None:
 def test_a_negated_value_is_named_by_its_opposite_when_that_saves_calls() -> None:
     # t1 = -(a b) costs a product and a sign change; its uses absorb the sign for free
     # (t2 = b + t1 is b - a b; the output -t1 is a b, computed in its row): flipped, the
-    # program saves the sign change and the output's. t3 = atan2(t1, a) is no sum or product:
-    # a value read there keeps its sign (atan2(-y, x) and -atan2(y, x) differ on the cut).
+    # program saves the sign change and the output's. t3 = atan2(t1, b) is no sum or product:
+    # a value read there keeps its sign, and its product keeps its call to -1.
     rng = np.random.default_rng(8)
     n = 64
     values = {a: rng.uniform(-1, 1, n), b: rng.uniform(-1, 1, n), k: 2.0, m: 3.0}
@@ -263,7 +263,7 @@ def test_generated_atan2_is_numpys_within_two_ulp() -> None:
         want = np.arctan2(y, x)
         finite = np.isfinite(want) & (want != 0)
         assert _ulps(out[finite], want[finite]) <= 2.0
-        zeros = want == 0  # the signs of zeros, and pi against -pi on the cut, exactly
+        zeros = want == 0  # the signs of zeros (pi against -pi: the ulps above)
         np.testing.assert_array_equal(np.signbit(out[zeros]), np.signbit(want[zeros]))
         np.testing.assert_array_equal(np.isnan(out), np.isnan(want))
     out = np.empty(3)  # a scalar operand (a 0-d array, as the lowering passes a parameter)

@@ -402,6 +402,11 @@ def fold_signs(
         for sym in expr.free_symbols:
             readers.setdefault(sym, []).append(index)
     scalar = set(scalars)
+
+    def cost(rhs: sp.Expr, uses: list[sp.Expr], outs: list[sp.Expr]) -> int:
+        return (_calls_of(rhs, scalar) + sum(_calls_of(e, scalar) for e in uses)
+                + sum(_calls_of(e, scalar, output=True) for e in outs))  # fmt: skip
+
     for index, (lhs, rhs) in enumerate(statements):
         if rhs.free_symbols <= scalar:
             scalar.add(lhs)
@@ -417,11 +422,6 @@ def fold_signs(
         flip = {lhs: -lhs}
         new_rhs, new_uses = -rhs, [e.xreplace(flip) for e in uses]
         new_outs = [e.xreplace(flip) for e in outs]
-
-        def cost(rhs: sp.Expr, uses: list[sp.Expr], outs: list[sp.Expr]) -> int:
-            return (_calls_of(rhs, scalar) + sum(_calls_of(e, scalar) for e in uses)
-                    + sum(_calls_of(e, scalar, output=True) for e in outs))  # fmt: skip
-
         if cost(new_rhs, new_uses, new_outs) < cost(rhs, uses, outs):
             statements[index] = (lhs, new_rhs)
             for k, e in zip(used, new_uses, strict=True):
