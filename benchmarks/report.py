@@ -87,16 +87,18 @@ def py(r: dict[str, Any], name: str) -> float | None:
     return None if found is None else float(found["min"])
 
 
-def ne_ratios(r: dict[str, Any], variant: str) -> list[tuple[str, int, float, float]]:
-    """(motion, n, NumPy ns/sample, Newton-Euler ns/sample) of the variant."""
+def ne_ratios(r: dict[str, Any], variant: str) -> list[tuple[str, int, float, float, float]]:
+    """(motion, n, NumPy ns/sample, Newton-Euler ns/sample, median ratio) of the variant, from
+    the rounds of ``harness/paired.py``: each side's best round, and the median over the rounds
+    of Newton-Euler / NumPy within a round."""
     rows = []
-    for name in r["python"]:
-        parts = name.split("/")
-        if parts[0] == "numpy" and parts[1] == variant:
-            ours, ne = py(r, name), py(r, "newton_euler/" + "/".join(parts[1:]))
-            if ours and ne:
-                n = int(parts[3])
-                rows.append((parts[2], n, ours / n * 1e9, ne / n * 1e9))
+    for name, sides in r.get("paired", {}).items():
+        _, v, motion, size = name.split("/")
+        if v == variant:
+            n = int(size)
+            ours, ne = sides["numpy"], sides["newton_euler"]
+            within = statistics.median(b / a for a, b in zip(ours, ne, strict=True))
+            rows.append((motion, n, min(ours) / n * 1e9, min(ne) / n * 1e9, within))
     return sorted(rows)
 
 
@@ -116,7 +118,7 @@ def targets(r: dict[str, Any]) -> str:
         rows.append([f"C forward dynamics, one call ({v})", ns(fd), "< 300 ns",
                      verdict(fd, 300, True)])  # fmt: skip
         for motion in ("generic", "rotation"):
-            ratios = [(ne / ours, n) for m, n, ours, ne in ne_ratios(r, v) if m == motion]
+            ratios = [(ne / ours, n) for m, n, ours, ne, _ in ne_ratios(r, v) if m == motion]
             if ratios:
                 worst = min(ratios)[0]
                 text = ", ".join(f"{x:.1f}x at 10^{len(str(k)) - 1}" for x, k in ratios)
@@ -138,10 +140,10 @@ def targets(r: dict[str, Any]) -> str:
         if single:
             rows.append([f"Python single call, `inverse_dynamics` ({v})", f"{single * 1e6:.3f} µs",
                          "< 1 µs", verdict(single * 1e6, 1, True)])  # fmt: skip
-        big = py(r, f"numpy/{v}/generic/1000000")
+        big = [ours for m, n, ours, _, _ in ne_ratios(r, v) if (m, n) == ("generic", 10**6)]
         if big:
-            rows.append([f"NumPy at 10^6, generic motion ({v})", f"{big * 1e3:.0f} ns/sample",
-                         "< 500 ns", verdict(big * 1e3, 500, True)])  # fmt: skip
+            rows.append([f"NumPy at 10^6, generic motion ({v})", f"{big[0]:.0f} ns/sample",
+                         "< 500 ns", verdict(big[0], 500, True)])  # fmt: skip
     regen = py(r, "regen/generate_check")
     if regen:
         rows.append(["full regeneration, `rpr3gen generate --check`", f"{regen:.2f} s", "< 5 s",
@@ -234,9 +236,27 @@ def generation(r: dict[str, Any]) -> str:
 
 
 def numpy_vs_ne(r: dict[str, Any]) -> str:
-    rows = [[v, m, f"10^{len(str(n)) - 1}", f"{ours:.0f} ns", f"{ne:.0f} ns", f"{ne / ours:.1f}x"]
-            for v in paper(r) for m, n, ours, ne in ne_ratios(r, v)]  # fmt: skip
-    return table(["variant", "motion", "samples", "NumPy", "Newton–Euler", "ratio"], rows)
+    rows = [[v, m, f"10^{len(str(n)) - 1}", str(len(r["paired"][f"paired/{v}/{m}/{n}"]["numpy"])),
+             f"{ours:.0f} ns", f"{ne:.0f} ns", f"{ne / ours:.1f}x", f"{within:.1f}x"]
+            for v in paper(r) for m, n, ours, ne, within in ne_ratios(r, v)]  # fmt: skip
+    head = ["variant", "motion", "samples", "rounds", "NumPy, best round", "Newton–Euler, best",
+            "ratio of the bests", "median of the rounds' ratios"]  # fmt: skip
+    return table(head, rows)
+
+
+def numpy_parts(r: dict[str, Any]) -> str:
+    """Where the NumPy inverse dynamics' time goes (``harness/numpy_parts.py``), ns per sample."""
+    rows = []
+    for v, x in sorted(r.get("numpy_parts", {}).items()):
+        steps = [("floor", x["floor"]), ("kernel", x["kernel"] - x["floor"]),
+                 ("checked", x["checked"] - x["kernel"]),
+                 ("evaluate", x["evaluate"] - x["checked"])]  # fmt: skip
+        rows.append([v, f"{x['calls']:.0f}", f"{x['floor']:.0f}",
+                     *(f"+{d:.0f} = {x[k]:.0f}" for k, d in steps[1:]),
+                     f"{x['evaluate'] / x['floor']:.2f}x"])  # fmt: skip
+    head = ["variant", "ufunc calls a block", "eager floor", "kernel", "+ failure checks",
+            "+ fresh outputs: `evaluate`", "`evaluate` / floor"]  # fmt: skip
+    return table(head, rows)
 
 
 def runs_note(tick: dict[str, Any]) -> str:
@@ -309,8 +329,20 @@ def paper_parts(r: dict[str, Any]) -> list[str]:
         *(functions(r, v) + "\n" for v in paper(r)),
         "## NumPy against Newton–Euler\n",
         "`evaluate(model, \"inverse_dynamics\", ...)` against `tests/newton_euler.py` on the same "
-        "samples (in chunks of 10^5), ns per sample, the best of pyperf's values.\n\n",
+        "samples (in chunks of 10^5), ns per sample, timed in turn in one process "
+        "(`harness/paired.py`): each round times both sides back to back, so that a slow spell "
+        "of this shared machine falls on both. The ratio of the two best rounds is the target's "
+        "figure; the median of the rounds' own ratios shows how far a spell moves it.\n\n",
         numpy_vs_ne(r),
+        "\nWhere the NumPy inverse dynamics' time goes, ns per sample at 10^5 samples of the "
+        "generic motion, each the best of its rounds (`harness/numpy_parts.py`). *Eager floor*: "
+        "the very ufunc calls of one block of the generated kernel, replayed on rows that stay "
+        "in cache, nothing between them; *kernel*: the generated kernel block by block into "
+        "outputs allocated once (above the floor: its working set streamed from the outer "
+        "caches, its Python statements); *failure checks*: `rpr3gen.failures.apply` after each "
+        "block, which reads the block's outputs again; *fresh outputs*: `evaluate` itself, whose "
+        "new output arrays' pages the kernel maps and zeroes at its first writes.\n\n",
+        numpy_parts(r),
         "\n## The control-loop examples' latencies\n",
         "Each program's own report, 3 s at 1 kHz (`examples/control_loop`). The C program "
         "runs several times and the run with the lowest tick p50 is shown (its FK, rest and "

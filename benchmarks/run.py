@@ -2,7 +2,9 @@
 
 Runs, over the paper's variants in ``generated/`` (``harness/samples.py``): the C per-function
 harness (``harness/cbench.py``: floor, single call, batch), the control-loop examples
-(``harness/examples.py``: their own tick latencies) and the Python benchmarks on pyperf
+(``harness/examples.py``: their own tick latencies), NumPy against the Newton-Euler solver timed
+in turn (``harness/paired.py``, a fresh process), the parts of the NumPy inverse dynamics'
+time (``harness/numpy_parts.py``, another) and the Python benchmarks on pyperf
 (``harness/pybench.py``, one pyperf run per group, fresh worker processes); and for every one of
 the 18 structures, on its own model: its generation time (``harness/generation.py``: cold and
 cached, fresh interpreters), the same C per-function harness and NumPy per function (pyperf).
@@ -42,8 +44,6 @@ BENCH = Path(__file__).resolve().parent
 REPO = BENCH.parent
 #: pyperf's options per group, full run / quick run (None: skipped).
 PYPERF: dict[str, tuple[list[str], list[str] | None]] = {
-    "numpy": (["--processes", "2", "--values", "3"], ["--processes", "1", "--values", "1"]),
-    "large": (["--processes", "1", "--values", "2", "--loops", "1"], None),
     "functions": (["--processes", "2", "--values", "3"], ["--processes", "1", "--values", "1"]),
     # 18 structures x 14 functions: one process each, no calibration (a call takes milliseconds)
     "structures": (
@@ -113,6 +113,20 @@ def run_pyperf(
     }  # fmt: skip
 
 
+def run_harness(script: str, quick: bool) -> dict[str, Any]:
+    """The JSON that ``harness/SCRIPT.py [--quick] -o FILE`` writes, run in a fresh process:
+    ``paired`` (NumPy and the Newton-Euler solver timed in turn) or ``numpy_parts`` (where the
+    NumPy inverse dynamics' time goes)."""
+    with tempfile.TemporaryDirectory(prefix=f"rpr3bench-{script}-") as tmp:
+        out = Path(tmp) / f"{script}.json"
+        subprocess.run(
+            [sys.executable, str(BENCH / "harness" / f"{script}.py"),
+             *(["--quick"] if quick else []), "-o", str(out)],
+            check=True,
+        )  # fmt: skip
+        return dict(json.loads(out.read_text()))
+
+
 def dump(value: Any, indent: str = "") -> str:
     """JSON with one measurement a line: a dict of numbers and strings stays on one line."""
     if not isinstance(value, dict) or not any(isinstance(v, dict) for v in value.values()):
@@ -164,6 +178,10 @@ def measure(results: dict[str, Any], structures: Sequence[str], quick: bool) -> 
     if paper:
         log("control-loop examples")
         results["examples"] = examples.run(2 if quick else examples.RUNS)
+        log("NumPy against Newton-Euler, in turn")
+        results["paired"] = run_harness("paired", quick)
+        log("NumPy inverse dynamics, where the time goes")
+        results["numpy_parts"] = run_harness("numpy_parts", quick)
     results["python"] = {}
     for group in PYPERF if paper else ("structures",):
         log(f"pyperf: {group}")

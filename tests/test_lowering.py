@@ -73,6 +73,7 @@ def _module_names(lowered, constants: dict[str, str]) -> dict[str, object]:
     """What the module template defines for the lowered lines: the ufuncs by name
     (``_multiply``) and the number constants as 0-d arrays (``_K0``)."""
     names: dict[str, object] = {f"_{ufunc}": getattr(np, ufunc) for ufunc in lowered.ufuncs}
+    names["sums"] = np.full(lowered.sums, np.nan)  # the function's ``sums`` argument
     if lowered.atan2:
         names["_atan2"] = _generated_numpy()._atan2
     names.update({name: np.array(eval(text), np.float64) for text, name in constants.items()})
@@ -108,6 +109,44 @@ def test_buffers_are_reused_and_aliases_and_constants_are_written() -> None:
     rows = {name: f"out[{i}]" for i, (name, _) in enumerate(code.outputs)}
     lowered = lower_numpy(code, {a: "a", b: "b"}, {k, m}, rows)
     assert lowered.buffers <= 3  # three live values at most, never one buffer per operation
+
+
+def test_each_output_row_is_summed_after_its_last_use() -> None:
+    # The runtime's failure checks read the outputs' finiteness from these sums, taken while
+    # each row is in cache: a row summed before its last write (here "first" is t1's row and
+    # t1 is still read by t2 and t3 after it is final) would miss what that write puts in it.
+    rng = np.random.default_rng(8)
+    n = 16
+    values = {a: rng.uniform(-1, 1, n), b: rng.uniform(1, 2, n), k: 2.0, m: 3.0}
+    code = StraightLine(
+        assignments=((t1, a * b + k), (t2, t1 * a - b), (t3, t2 / t1)),
+        outputs=(("first", t1), ("ratio", t3), ("zero", sp.Integer(0)), ("again", t2)),
+        ops_before=0,
+        ops_after=0,
+    )
+    rows = {name: f"out[{i}]" for i, (name, _) in enumerate(code.outputs)}
+    constants: dict[str, str] = {}
+    lowered = lower_numpy(code, {a: "a", b: "b"}, {k, m}, rows, constants)
+    assert lowered.sums == 4
+    lines = lowered.vector_lines
+    for i, row in enumerate(rows.values()):
+        at = lines.index(f"sums[{i}] = _add.reduce({row})")
+        assert not any(row in line for line in lines[at + 1 :]), row  # never touched again
+        assert any(row in line for line in lines[:at]), row  # written before
+    for blank in (None, 3):  # all finite; then a NaN input in sample 3
+        a_values = values[a].copy()
+        if blank is not None:
+            a_values[blank] = np.nan
+        out = np.full((4, n), np.nan)
+        scope = {"numpy": np, "out": out, "a": a_values, "b": values[b], "k": 2.0, "m": 3.0,
+                 **_module_names(lowered, constants)}  # fmt: skip
+        for i in range(lowered.buffers):
+            scope[f"w{i}"] = np.empty(n)
+        exec("\n".join(lowered.scalar_lines + lines), scope)
+        sums = scope["sums"]
+        np.testing.assert_array_equal(sums, np.add.reduce(out, axis=1))  # the same sums
+        assert np.isfinite(sums).tolist() == np.isfinite(out).all(axis=1).tolist()
+        assert np.isfinite(sums).all() == (blank is None)
 
 
 def test_a_value_read_only_by_an_output_keeps_its_buffer() -> None:
@@ -312,6 +351,7 @@ def test_operands_are_arrays_and_outputs_positional_with_the_scalars_values() ->
         scope = {"numpy": np, "out": out, "a": values[a], "b": values[b],
                  "k": np.float64(values[k]), "m": np.float64(values[m])}  # fmt: skip
         scope.update({f"_{u}": getattr(np, u) for u in lowered.ufuncs})
+        scope["sums"] = np.empty(lowered.sums)
         for text, name in constants.items():
             scope[name] = np.array(eval(text), np.float64) if as_arrays else eval(text)
         for i in range(lowered.buffers):

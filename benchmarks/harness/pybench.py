@@ -6,10 +6,6 @@ only says what to time. Each benchmark is a pyperf *time function* whose setup (
 evaluators) happens before its clock starts. Groups (one pyperf run each, so that each has its
 own repeat counts):
 
-- ``numpy``: ``rpr3gen.evaluate(model, "inverse_dynamics", ..., backend="numpy")`` and the
-  independent Newton-Euler solver (``tests/newton_euler.py``, in chunks of 10^5 samples so that
-  its (n, 21, 21) systems fit) on the same samples, per variant and motion, at 10^4 and 10^5;
-- ``large``: the same at 10^6 (a call takes seconds: run with ``--loops 1``);
 - ``functions``: ``evaluate(..., backend="numpy")`` of every measurable function at 10^5;
 - ``structures``: the same for the structures named by ``--structures`` (every one by default),
   each on its own model and generic motion (``harness/samples.py``);
@@ -17,6 +13,9 @@ own repeat counts):
   generic motion's first pose, and the same call with a NaN input (the ctypes floor);
 - ``peers``: MuJoCo's ``mj_forward`` on the same robot (skipped without MuJoCo);
 - ``regen``: ``rpr3gen generate --check``, a fresh interpreter end to end.
+
+NumPy against the Newton-Euler solver is not here: ``harness/paired.py`` times the two in turn,
+in one process, so that a spell of this shared machine falls on both.
 
 The groups but ``structures`` measure the paper's variants. Benchmark names are
 ``group/variant/...`` (see :func:`names`; ``structures`` names its own ``functions/...``);
@@ -40,9 +39,7 @@ import rpr3gen
 from harness import samples
 from harness.samples import test_module
 
-SIZES = {"numpy": (10**4, 10**5), "large": (10**6,)}
-NE_CHUNK = 10**5
-GROUPS = ("numpy", "large", "functions", "structures", "calls", "peers", "regen")
+GROUPS = ("functions", "structures", "calls", "peers", "regen")
 
 
 def timed(setup: Callable[[], Callable[[], object]]) -> Callable[[int], float]:
@@ -59,35 +56,6 @@ def timed(setup: Callable[[], Callable[[], object]]) -> Callable[[int], float]:
         return time.perf_counter() - start
 
     return run
-
-
-def numpy_benchmarks(variant: str, sizes: tuple[int, ...]) -> dict[str, Callable[[int], float]]:
-    model = samples.model(variant)
-    ne = test_module("newton_euler")
-    found: dict[str, Callable[[int], float]] = {}
-    for motion in samples.MOTIONS:
-        for n in sizes:
-
-            def ours(motion: str = motion, n: int = n) -> Callable[[], object]:
-                a = samples.motion(variant, motion, n)
-                return lambda: rpr3gen.evaluate(
-                    model, "inverse_dynamics", [a["q"], a["qd"], a["qdd"]]
-                )
-
-            def reference(motion: str = motion, n: int = n) -> Callable[[], object]:
-                a = samples.motion(variant, motion, n)
-                params = dict(model.params)
-
-                def solve() -> None:
-                    for k in range(0, n, NE_CHUNK):
-                        s = slice(k, k + NE_CHUNK)
-                        ne.solve(params, variant, a["q"][s], a["qd"][s], a["qdd"][s])
-
-                return solve
-
-            found[f"numpy/{variant}/{motion}/{n}"] = timed(ours)
-            found[f"newton_euler/{variant}/{motion}/{n}"] = timed(reference)
-    return found
 
 
 def function_benchmarks(variant: str) -> dict[str, Callable[[int], float]]:
@@ -172,12 +140,9 @@ def names(group: str, structures: tuple[str, ...] = ()) -> dict[str, Callable[[i
         return {k: v for s in structures for k, v in function_benchmarks(s).items()}
     found: dict[str, Callable[[int], float]] = {}
     for variant in samples.paper_variants():
-        if group in SIZES:
-            found.update(numpy_benchmarks(variant, SIZES[group]))
-        else:
-            make = {"functions": function_benchmarks, "calls": call_benchmarks,
-                    "peers": peer_benchmarks}[group]  # fmt: skip
-            found.update(make(variant))
+        make = {"functions": function_benchmarks, "calls": call_benchmarks,
+                "peers": peer_benchmarks}[group]  # fmt: skip
+        found.update(make(variant))
     return found
 
 

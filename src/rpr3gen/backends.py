@@ -144,7 +144,7 @@ def evaluate(
     for block in _blocks(n, progress, ev.block):
         ins, outs = [a[block] for a in arrays], [o[block] for o in outputs]
         failed = ev.run(info, params, ins, outs, count)
-        if failed != 0:  # unknown (NumPy), or the C counted some: find them while in cache
+        if failed != 0:  # unknown (NumPy could not tell), or some failed: find them in cache
             codes[block] = failures.apply(info, ins, outs, applied=ev.applies_checks)
     public = [o for o, arg in zip(outputs, info.outputs, strict=True) if not arg.hidden]
     return public, codes

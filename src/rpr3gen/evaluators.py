@@ -20,6 +20,7 @@ from typing import Protocol
 
 import numpy as np
 
+from rpr3gen import failures
 from rpr3gen.errors import InputError
 from rpr3gen.loader import numpy_module
 from rpr3gen.manifest import FunctionInfo, Variant
@@ -102,7 +103,10 @@ class NumpyEvaluator:
 
     One thread: ``threads`` is accepted and ignored. The generated functions' scratch rows
     (``work``) are one array per thread, kept between calls: fresh ones would cost mapping and
-    zeroing new pages at every block.
+    zeroing new pages at every block. :meth:`run` returns 0 when no sample failed, as the
+    generated function's sums of its output rows and one reduction of each other array tested
+    tell (:func:`rpr3gen.failures.none_failed`), else None: unknown, the per-sample checks
+    decide (``rpr3gen.failures.apply``).
     """
 
     applies_checks = False
@@ -125,6 +129,13 @@ class NumpyEvaluator:
             work = self._scratch.work = np.empty(shape)
         return work
 
+    def _sums(self, rows: int) -> np.ndarray:
+        """This thread's array of output-row sums, at least ``rows`` long."""
+        sums = getattr(self._scratch, "sums", None)
+        if sums is None or sums.shape[0] < rows:
+            sums = self._scratch.sums = np.empty(rows)
+        return sums
+
     def allocate(self, function: FunctionInfo, n: int) -> list[np.ndarray]:
         return [np.empty((o.size, n)).T for o in function.outputs]
 
@@ -145,10 +156,15 @@ class NumpyEvaluator:
         rows = getattr(self.module, "WORK_ROWS", {}).get(function.numpy_function)
         if rows is None:  # generated before the work argument
             call(params, *inputs, *(o.T for o in outputs))
-        else:
-            work = self._work(rows, inputs[0].shape[0])
+            return None
+        work = self._work(rows, inputs[0].shape[0])
+        count = getattr(self.module, "OUTPUT_ROWS", {}).get(function.numpy_function)
+        if count is None:  # generated before the sums argument
             call(params, *inputs, *(o.T for o in outputs), work=work)
-        return None
+            return None
+        sums = self._sums(count)
+        call(params, *inputs, *(o.T for o in outputs), work=work, sums=sums)
+        return 0 if failures.none_failed(function, inputs, outputs, sums[:count]) else None
 
 
 class CEvaluator:

@@ -17,7 +17,7 @@ import numpy as np
 
 from rpr3gen.manifest import CheckInfo, FunctionInfo
 
-__all__ = ["apply", "finite_rows", "return_codes"]
+__all__ = ["apply", "finite_rows", "none_failed", "return_codes"]
 
 
 def finite_rows(array: np.ndarray) -> np.ndarray:
@@ -50,13 +50,26 @@ def _tested(
     return [o for o, i in zip(outputs, function.outputs, strict=True) if not i.hidden]
 
 
-def _none_failed(
-    function: FunctionInfo, inputs: Sequence[np.ndarray], outputs: Sequence[np.ndarray]
+def none_failed(
+    function: FunctionInfo,
+    inputs: Sequence[np.ndarray],
+    outputs: Sequence[np.ndarray],
+    output_sums: np.ndarray | None = None,
 ) -> bool:
     """Every sample passes every check that :func:`return_codes` applies (a NaN fails them):
-    one reduction per array, where the per-sample codes cost a dozen more passes."""
+    one reduction per array, where the per-sample codes cost a dozen more passes.
+
+    ``output_sums``: the sums of the output rows over the samples, as the generated NumPy
+    functions write them (their ``sums`` argument, taken while each row is in cache): then the
+    outputs are finite when these sums are, and are not read again. A sum that overflows makes
+    this answer False; the per-sample codes then decide.
+    """
     with np.errstate(invalid="ignore"):
         for check in function.checks:
+            if check.kind == "outputs_not_finite" and output_sums is not None:
+                if not np.isfinite(output_sums).all():
+                    return False
+                continue
             tested = _tested(check, function, inputs, outputs)
             if isinstance(tested, list):
                 if not all(np.isfinite(a).all() for a in tested):
@@ -102,7 +115,7 @@ def return_codes(
         if later:
             codes[failed & pending] = later[0]
         return codes
-    if _none_failed(function, inputs, outputs):  # the usual case: one pass over each array
+    if none_failed(function, inputs, outputs):  # the usual case: one pass over each array
         return codes
     with np.errstate(invalid="ignore"):
         for check in function.checks:

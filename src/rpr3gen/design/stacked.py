@@ -90,18 +90,21 @@ def evaluate_stacked(
     params = np.asarray(params, dtype=np.float64)
     ev = evaluator(variant, "numpy")
     outputs = ev.allocate(info, n)
+    codes = np.zeros(n, dtype=np.intc)
     for lo in range(0, n, BLOCK):
         block = slice(lo, min(lo + BLOCK, n))
         ins, outs = [a[block] for a in arrays], [o[block] for o in outputs]
         if params.ndim == 1:
-            ev.run(info, params, ins, outs)
-            continue
-        p = np.ascontiguousarray(params[:, block])
-        try:
-            ev.run(info, p, ins, outs)
-        except ValueError:
-            _by_runs(ev, info, p, ins, outs)
-    codes = failures.return_codes(info, arrays, outputs, applied=False)
+            failed = ev.run(info, params, ins, outs)
+        else:
+            p = np.ascontiguousarray(params[:, block])
+            try:
+                failed = ev.run(info, p, ins, outs)
+            except ValueError:
+                _by_runs(ev, info, p, ins, outs)
+                failed = None
+        if failed != 0:  # unknown: the per-sample codes of the block
+            codes[block] = failures.return_codes(info, ins, outs, applied=False)
     values = {
         name: out[:, k]
         for arg, out in zip(info.outputs, outputs, strict=True)

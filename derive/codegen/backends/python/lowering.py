@@ -22,10 +22,15 @@ where its uses take the sign for free (:func:`fold_signs`): 3-4 % fewer calls in
 dynamics. ``atan2`` is the module's ``_atan2`` (``numpy.arctan`` of the quotient and the
 quadrant's multiple of pi: ~12 ns a value where ``numpy.arctan2`` costs ~20), ``sin`` and ``cos``
 of one argument its ``_sincos``.
+
+Last, each output row is summed into the function's ``sums`` argument right after the last line
+that names it (:func:`add_sums`): the runtime's failure checks learn from these sums that every
+output is finite without reading the block's outputs again, out of cache.
 """
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 
 import sympy as sp
@@ -47,6 +52,8 @@ class LoweredNumpy:
     sincos: bool = False
     ufuncs: frozenset[str] = frozenset()
     atan2: bool = False
+    #: Output rows whose sums the function writes into its ``sums`` argument (:func:`add_sums`).
+    sums: int = 0
 
 
 #: Work rows the module's ``_sincos(x, s, c, work)`` helper takes.
@@ -431,6 +438,34 @@ def fold_signs(
     return statements, outputs
 
 
+def add_sums(lines: list[str], rows: list[str]) -> list[str]:
+    """``lines`` with ``sums[k] = _add.reduce(row)`` after the last line that names output row
+    ``rows[k]`` (at the end for a row no line names).
+
+    The runtime's failure checks must know whether every output is finite. Read again after the
+    kernel, a block's outputs come from the outer caches or memory: ~50 ns a sample of the
+    inverse dynamics. Each row summed right after its last write is still in cache, and one
+    non-finite value makes its sum non-finite (an overflowing sum only sends the block to the
+    per-sample checks): about half of that (``benchmarks/harness/numpy_parts.py``).
+    """
+    last: dict[str, int] = {}
+    patterns = {row: re.compile(rf"(?<![\w.]){re.escape(row)}") for row in rows}
+    for index, line in enumerate(lines):
+        for row, pattern in patterns.items():
+            if pattern.search(line):
+                last[row] = index
+    after: dict[int, list[int]] = {}
+    for k, row in enumerate(rows):
+        after.setdefault(last.get(row, len(lines) - 1), []).append(k)
+    found = []
+    for index, line in enumerate(lines):
+        found.append(line)
+        found += [f"sums[{k}] = _add.reduce({rows[k]})" for k in after.get(index, [])]
+    if not lines:
+        found += [f"sums[{k}] = _add.reduce({row})" for k, row in enumerate(rows)]
+    return found
+
+
 def lower_numpy(
     code: StraightLine,
     inputs: dict[sp.Symbol, str],
@@ -499,11 +534,13 @@ def lower_numpy(
         state.emit(expr, row)
     hoisted = [f"{name} = numpy.array({text}, numpy.float64)"
                for text, name in state.hoisted.items()]  # fmt: skip
+    summed = list(dict.fromkeys(output_rows.values()))
     return LoweredNumpy(
         scalar_lines,
-        hoisted + state.lines,
+        hoisted + add_sums(state.lines, summed),
         state.count,
         bool(pairs),
-        frozenset(state.ufuncs),
+        frozenset(state.ufuncs | {"add"}),
         state.atan2,
+        len(summed),
     )
