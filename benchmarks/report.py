@@ -337,11 +337,13 @@ def paper_parts(r: dict[str, Any]) -> list[str]:
         "\nWhere the NumPy inverse dynamics' time goes, ns per sample at 10^5 samples of the "
         "generic motion, each the best of its rounds (`harness/numpy_parts.py`). *Eager floor*: "
         "the very ufunc calls of one block of the generated kernel, replayed on rows that stay "
-        "in cache, nothing between them; *kernel*: the generated kernel block by block into "
-        "outputs allocated once (above the floor: its working set streamed from the outer "
-        "caches, its Python statements); *failure checks*: `rpr3gen.failures.apply` after each "
-        "block, which reads the block's outputs again; *fresh outputs*: `evaluate` itself, whose "
-        "new output arrays' pages the kernel maps and zeroes at its first writes.\n\n",
+        "in cache, nothing between them (the sums of the output rows included); *kernel*: the "
+        "generated function block by block into outputs allocated once (above the floor: its "
+        "working set streamed from the outer caches, its Python statements); *failure checks*: "
+        "the evaluator's short cut on those sums and the other tested arrays "
+        "(`rpr3gen.failures.none_failed`), and the per-sample checks of a block it cannot "
+        "clear; *fresh outputs*: `evaluate` itself, whose new output arrays' pages the kernel "
+        "maps and zeroes at its first writes.\n\n",
         numpy_parts(r),
         "\n## The control-loop examples' latencies\n",
         "Each program's own report, 3 s at 1 kHz (`examples/control_loop`). The C program "
