@@ -257,3 +257,31 @@ def test_the_codes_short_cut_gives_the_per_sample_codes(
             per_sample = failures.return_codes(info, ins, outs)
         assert got.tolist() == per_sample.tolist(), name
         assert got.tolist() == [0] * 4 + [code or 0] + [0], name
+
+
+@pytest.mark.parametrize("actuation", ACTUATIONS)
+def test_a_module_without_output_sums_gets_the_same_codes(
+    actuation: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # A NumPy module generated before the ``sums`` argument has no OUTPUT_ROWS: the evaluator
+    # then calls it without sums and leaves the codes to the per-sample checks, which must give
+    # what the short cut gives (here on a block with a failed sample and one without).
+    model = _model(actuation)
+    variant = manifest.load(actuation)
+    p = model.params
+    q = np.tile([0.01, -0.02, 0.1], (8, 1))
+    q[5] = [p["xB1"] - p["xB3"], p["yB1"] - p["yB3"], 0.0]  # leg B of zero length: singular
+    zeros = np.zeros_like(q)
+    ev = evaluator(variant, "numpy")
+    info = variant.function("inverse_dynamics")
+    for n in (8, 4):
+        ins = [q[:n], zeros[:n], zeros[:n]]
+        with_sums = rpr3gen.evaluate(model, "inverse_dynamics", ins)
+        with monkeypatch.context() as patch:
+            patch.delattr(ev.module, "OUTPUT_ROWS")
+            outs = ev.allocate(info, n)
+            assert ev.run(info, model.vector(variant.param_names), ins, outs) is None
+            without = rpr3gen.evaluate(model, "inverse_dynamics", ins)
+        want = [0] * 5 + [variant.return_codes["SINGULAR"]] + [0] * 2
+        assert with_sums[1].tolist() == without[1].tolist() == want[:n]
+        np.testing.assert_array_equal(with_sums[0][0], without[0][0])
