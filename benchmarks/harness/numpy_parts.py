@@ -16,8 +16,9 @@ its rounds, the four measures alternating within a round):
   in cache, with nothing between the calls but the replay loop. What the kernel spends above
   it is its working set (rows streamed from the outer caches) and its Python statements.
 
-``calls`` is the number of calls one block makes (the ``_sincos`` and ``_atan2`` helpers'
-included; the per-block constants and the helpers' rare fallbacks are not).
+``calls`` is the number of calls one block makes: the ``_sincos`` and ``_atan2`` helpers' and
+the sums of the output rows included, the per-block constants and the helpers' rare fallbacks
+not (``tests/test_benchmark_numpy.py`` counts them from the module's text).
 """
 
 from __future__ import annotations
@@ -126,7 +127,8 @@ def replay(log: list[tuple[Callable[..., Any], tuple, dict]], block: int) -> Cal
     return run
 
 
-def best(call: Callable[[], object]) -> float:
+def seconds(call: Callable[[], object]) -> float:
+    """Seconds of one call."""
     start = time.perf_counter()
     call()
     return time.perf_counter() - start
@@ -171,7 +173,7 @@ def parts(variant: str, rounds: int) -> dict[str, float]:
         call()
     for _ in range(rounds):
         for name, call in measures.items():
-            times[name].append(best(call))
+            times[name].append(seconds(call))
     per_sample = {name: min(t) / N * 1e9 for name, t in times.items()}
     return {**per_sample, "calls": len(log), "block": first.stop - first.start}
 
