@@ -251,11 +251,13 @@ def numpy_parts(r: dict[str, Any]) -> str:
         steps = [("floor", x["floor"]), ("kernel", x["kernel"] - x["floor"]),
                  ("checked", x["checked"] - x["kernel"]),
                  ("evaluate", x["evaluate"] - x["checked"])]  # fmt: skip
+        fresh = f"{x['fresh']:.0f} = {x['fresh'] / x['floor']:.2f}x" if "fresh" in x else ""
         rows.append([v, f"{x['calls']:.0f}", f"{x['floor']:.0f}",
-                     *(f"+{d:.0f} = {x[k]:.0f}" for k, d in steps[1:]),
-                     f"{x['evaluate'] / x['floor']:.2f}x"])  # fmt: skip
+                     *(f"{d:+.0f} = {x[k]:.0f}" for k, d in steps[1:]),
+                     f"{x['evaluate'] / x['floor']:.2f}x", fresh])  # fmt: skip
     head = ["variant", "ufunc calls a block", "eager floor", "kernel", "+ failure checks",
-            "+ fresh outputs: `evaluate`", "`evaluate` / floor"]  # fmt: skip
+            "+ the rest: `evaluate`", "`evaluate` / floor",
+            "`evaluate`, new output pages / floor"]  # fmt: skip
     return table(head, rows)
 
 
@@ -342,8 +344,11 @@ def paper_parts(r: dict[str, Any]) -> list[str]:
         "working set streamed from the outer caches, its Python statements); *failure checks*: "
         "the evaluator's short cut on those sums and the other tested arrays "
         "(`rpr3gen.failures.none_failed`), and the per-sample checks of a block it cannot "
-        "clear; *fresh outputs*: `evaluate` itself, whose new output arrays' pages the kernel "
-        "maps and zeroes at its first writes.\n\n",
+        "clear; *the rest*: `evaluate` itself, called again and again with each result dropped "
+        "before the next call, so that its outputs reuse that result's memory "
+        "(`rpr3gen.buffers`); *new output pages*: the same with that reuse off, as a first call "
+        "or one whose caller keeps its earlier results: the kernel maps and zeroes the new "
+        "arrays' pages at their first writes.\n\n",
         numpy_parts(r),
         "\n## The control-loop examples' latencies\n",
         "Each program's own report, 3 s at 1 kHz (`examples/control_loop`). The C program "

@@ -1,11 +1,15 @@
 """Where the NumPy inverse dynamics' time goes: ``python harness/numpy_parts.py [--quick] -o F``.
 
 Per paper variant, on :data:`N` samples of the generic motion, ns per sample (each the best of
-its rounds, the four measures alternating within a round):
+its rounds, the five measures alternating within a round):
 
 - ``evaluate``: ``rpr3gen.evaluate(model, "inverse_dynamics", ..., backend="numpy")``, as a user
-  calls it: the input checks, the outputs' allocation (their pages mapped and zeroed by the
-  kernel at their first write), the generated kernel block by block, the failure checks;
+  calls it again and again, each result dropped before the next call: the input checks, the
+  outputs' allocation (the memory of the result dropped, reused: :mod:`rpr3gen.buffers`), the
+  generated kernel block by block, the failure checks;
+- ``fresh``: the same with the pool of output memory off, as a first call or one whose caller
+  keeps the earlier results: the outputs' pages are new, and the kernel maps and zeroes each at
+  its first write;
 - ``checked``: the NumPy evaluator block by block, as ``evaluate`` runs it, into outputs
   allocated once (their pages mapped): the generated kernel, the failure checks' short cut
   (``rpr3gen.failures.none_failed`` on the output rows' sums that the kernel takes) and, when
@@ -36,7 +40,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 import rpr3gen
 from harness import samples
-from rpr3gen import backends, failures, variants
+from rpr3gen import backends, buffers, failures, variants
 
 N = 10**5
 #: Rounds, full run / quick run.
@@ -135,7 +139,7 @@ def seconds(call: Callable[[], object]) -> float:
 
 
 def parts(variant: str, rounds: int) -> dict[str, float]:
-    """The four measures of this module for one variant, ns per sample."""
+    """The five measures of this module for one variant, ns per sample."""
     model = samples.model(variant)
     a = samples.motion(variant, "generic", N)
     inputs = [a["q"], a["qd"], a["qdd"]]
@@ -162,8 +166,20 @@ def parts(variant: str, rounds: int) -> dict[str, float]:
     log = record(ev.module, lambda: ev.run(info, params, [x[first] for x in inputs], one_block))
     floor = replay(log, first.stop - first.start)
     kept = ev.allocate(info, N)
+
+    def evaluate() -> object:
+        return rpr3gen.evaluate(model, "inverse_dynamics", inputs, backend="numpy")
+
+    def fresh() -> object:
+        keep, buffers.OUTPUTS.keep = buffers.OUTPUTS.keep, 0
+        try:
+            return evaluate()
+        finally:
+            buffers.OUTPUTS.keep = keep
+
     measures: dict[str, Callable[[], object]] = {
-        "evaluate": lambda: rpr3gen.evaluate(model, "inverse_dynamics", inputs, backend="numpy"),
+        "fresh": fresh,
+        "evaluate": evaluate,
         "checked": lambda: kernel(kept, True),
         "kernel": lambda: kernel(kept, False),
         "floor": lambda: [floor() for _ in blocks],

@@ -120,7 +120,9 @@ def evaluate(
 
     Returns:
         The outputs of the function's interface, each seen as (n, size), and the (n,) return
-        codes (0: ok). The outputs of a failed sample are NaN, whatever the backend.
+        codes (0: ok). The outputs of a failed sample are NaN, whatever the backend. Large
+        outputs reuse the memory of earlier results that no one refers to any more
+        (:mod:`rpr3gen.buffers`; :func:`rpr3gen.buffers.release` gives it back).
     """
     variant, info = variants.load_function(model.structure, model.generated, function)
     if len(inputs) != len(info.inputs):

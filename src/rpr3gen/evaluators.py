@@ -21,6 +21,7 @@ from typing import Protocol
 import numpy as np
 
 from rpr3gen import failures
+from rpr3gen.buffers import OUTPUTS
 from rpr3gen.errors import InputError
 from rpr3gen.loader import numpy_module
 from rpr3gen.manifest import FunctionInfo, Variant
@@ -81,7 +82,8 @@ class Evaluator(Protocol):
     block: int  # samples per call of run() from rpr3gen.evaluate (bounds temporaries, progress)
 
     def allocate(self, function: FunctionInfo, n: int) -> list[np.ndarray]:
-        """Uninitialised outputs for n samples, each seen as (n, size)."""
+        """Uninitialised outputs for n samples, each seen as (n, size); a large one reuses the
+        memory of outputs their callers dropped (:mod:`rpr3gen.buffers`)."""
         ...
 
     def run(
@@ -137,7 +139,7 @@ class NumpyEvaluator:
         return sums
 
     def allocate(self, function: FunctionInfo, n: int) -> list[np.ndarray]:
-        return [np.empty((o.size, n)).T for o in function.outputs]
+        return [OUTPUTS.empty(o.size * n).reshape(o.size, n).T for o in function.outputs]
 
     def run(
         self,
@@ -189,8 +191,11 @@ class CEvaluator:
         self.library = cbackend.library(variant)
 
     def allocate(self, function: FunctionInfo, n: int) -> list[np.ndarray]:
-        return [np.full((n, o.size), np.nan) if o.hidden else np.empty((n, o.size))
-                for o in function.outputs]  # fmt: skip
+        outputs = [OUTPUTS.empty(n * o.size).reshape(n, o.size) for o in function.outputs]
+        for out, o in zip(outputs, function.outputs, strict=True):
+            if o.hidden:
+                out.fill(np.nan)
+        return outputs
 
     def run(
         self,
