@@ -368,3 +368,88 @@ def test_operands_are_arrays_and_outputs_positional_with_the_scalars_values() ->
     x, y = values[a], values[b]
     want = 2.0 * x - 3 * y + 2.0 * y**2 - x * y / 3 + 0.7 / (x**2 + 1)
     np.testing.assert_allclose(got, want, rtol=1e-13, atol=1e-13)
+
+
+def _legs_program() -> tuple[StraightLine, dict[str, sp.Symbol]]:
+    """Three legs' statements named alike (``r_A``, ``r_B``, ``r_C``), their parameters
+    (``pA`` ...), a platform value reading each leg, then more leg statements reading it."""
+    s = {name: sp.Symbol(name, real=True) for name in
+         ["pA", "pB", "pC", "c", "u", "v", "z", "h"]
+         + [f"{x}_{leg}" for x in "rsqpyg" for leg in "ABC"]}  # fmt: skip
+    lines = []
+    for leg in "ABC":
+        lines += [(s[f"r_{leg}"], s["u"] + s[f"p{leg}"]), (s[f"s_{leg}"], s[f"r_{leg}"] * s["v"])]
+    for leg in "ABC":
+        lines += [
+            (s[f"q_{leg}"], s[f"s_{leg}"] ** 2 + s["c"]),
+            (s[f"p_{leg}"], sp.sqrt(s[f"q_{leg}"])),
+        ]
+    lines.append((s["z"], s["p_A"] + s["p_B"] * s["u"] - s["p_C"]))
+    for leg in "ABC":
+        lines += [(s[f"y_{leg}"], s["z"] * s[f"s_{leg}"] - s["c"]),
+                  (s[f"g_{leg}"], s[f"y_{leg}"] / s[f"q_{leg}"])]  # fmt: skip
+    lines.append((s["h"], s["r_A"] * s["r_C"]))  # r_B is dead long before r_A and r_C
+    outputs = [("p_A", s["p_A"]), ("p_B", s["p_B"]), ("p_C", s["p_C"]), ("z", s["z"]),
+               ("y_A", s["y_A"]), ("y_C", s["y_C"]), ("y_B", s["y_B"]),  # not in the legs' order
+               ("g_A", s["g_A"]), ("g_B", s["g_B"]), ("g_C", s["g_C"]), ("h", s["h"])]  # fmt: skip
+    return StraightLine(tuple(lines), tuple(outputs), 0, 0), s
+
+
+def _run_legs(lowered, constants, s, values, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """The lowered lines run as the module runs them: rows ``wK`` of one work array, and the
+    (3, n) blocks ``tK`` over three of its rows."""
+    out = np.full((11, n), np.nan)
+    scope = {"numpy": np, "out": out, **{str(x): values[str(x)] for x in
+             (s["pA"], s["pB"], s["pC"], s["c"], s["u"], s["v"])},
+             **_module_names(lowered, constants)}  # fmt: skip
+    work = np.full((max(lowered.buffers, 1), n), np.nan)
+    for i in range(lowered.buffers):
+        scope[f"w{i}"] = work[i]
+    for first in lowered.triples:
+        scope[f"t{first}"] = work[first : first + 3]
+    exec("\n".join(lowered.scalar_lines + lowered.vector_lines), scope)
+    return out, scope["sums"]
+
+
+def test_the_legs_statements_run_as_one_call_for_three_legs(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # The three legs' statements that are one expression run on (3, n) blocks: fewer calls, the
+    # same values as each leg computed alone (here by NumPy directly), the legs' consecutive
+    # output rows written at once and summed; a block of three rows is only ever three free
+    # rows, and the row of a leg whose value is dead is free while the other legs' rows of its
+    # block are still read (r_B dies at s, r_A and r_C live to h).
+    from rpr3gen_derive.codegen.backends.python import lowering
+
+    code, s = _legs_program()
+    rng = np.random.default_rng(5)
+    n = 32
+    values = {"pA": 0.3, "pB": -0.2, "pC": 0.5, "c": 1.5,
+              "u": rng.uniform(-1, 1, n), "v": rng.uniform(-1, 1, n)}  # fmt: skip
+    inputs = {s["u"]: "u", s["v"]: "v"}
+    params = {s["pA"], s["pB"], s["pC"], s["c"]}
+    rows = {name: f"out[{i}]" for i, (name, _) in enumerate(code.outputs)}
+    constants: dict[str, str] = {}
+    stacked = lower_numpy(code, inputs, params, rows, constants)
+    assert stacked.triples, stacked.vector_lines
+    assert any("out[0:3]" in line for line in stacked.vector_lines)  # p_A, p_B, p_C at once
+    assert not any("out[4:7]" in line for line in stacked.vector_lines)  # y: another order
+    got, sums = _run_legs(stacked, constants, s, values, n)
+
+    u, v, c = values["u"], values["v"], values["c"]
+    r = {leg: u + values[f"p{leg}"] for leg in "ABC"}
+    sv = {leg: r[leg] * v for leg in "ABC"}
+    q = {leg: sv[leg] ** 2 + c for leg in "ABC"}
+    p = {leg: np.sqrt(q[leg]) for leg in "ABC"}
+    z = p["A"] + p["B"] * u - p["C"]
+    y = {leg: z * sv[leg] - c for leg in "ABC"}
+    want = np.array([p["A"], p["B"], p["C"], z, y["A"], y["C"], y["B"],
+                     *(y[leg] / q[leg] for leg in "ABC"), r["A"] * r["C"]])  # fmt: skip
+    np.testing.assert_allclose(got, want, rtol=1e-14, atol=1e-15)
+    np.testing.assert_array_equal(sums, np.add.reduce(got, axis=1))
+
+    monkeypatch.setattr(lowering, "MIN_GROUPS", 10**6)  # the same program, leg by leg
+    alone = lower_numpy(code, inputs, params, rows, {})
+    assert not alone.triples
+    # r, s, q (two operations) and p: five operations, each one call for three legs
+    assert len(_calls(stacked)) == len(_calls(alone)) - 2 * 5

@@ -53,13 +53,11 @@ HOT_ROWS = 2
 class _Recorder:
     """Stands for a ufunc in the generated module: calls it, and logs the call's form."""
 
-    def __init__(self, ufunc: np.ufunc, log: list[tuple[Callable[..., Any], tuple, dict]]):
-        self.ufunc, self.log = ufunc, log
+    def __init__(self, ufunc: np.ufunc, log: list[tuple[Callable[..., Any], tuple, dict]], n: int):
+        self.ufunc, self.log, self.n = ufunc, log, n
 
     def _form(self, call: Callable[..., Any], args: tuple, kwargs: dict) -> None:
-        kinds = tuple(("row", a.dtype) if isinstance(a, np.ndarray) and a.ndim else ("scalar", a)
-                      for a in args)  # fmt: skip
-        self.log.append((call, kinds, kwargs))
+        self.log.append((call, tuple(kind(a, self.n) for a in args), kwargs))
 
     def __call__(self, *args: Any, **kwargs: Any) -> Any:
         self._form(self.ufunc, args, kwargs)
@@ -70,29 +68,41 @@ class _Recorder:
         return self.ufunc.reduce(*args, **kwargs)
 
 
+def kind(a: Any, n: int) -> tuple[str, Any, tuple[int, ...]]:
+    """An operand's kind: ``("row", dtype, lead)`` for an array of the block's ``n`` samples
+    (``lead``: its shape before them, ``(3,)`` for the legs' (3, n) blocks), else
+    ``("scalar", a, ())`` (a 0-d constant, the legs' (3, 1) parameter column, ``sums``)."""
+    if isinstance(a, np.ndarray) and a.ndim and a.shape[-1] == n:
+        return ("row", a.dtype, a.shape[:-1])
+    return ("scalar", a, ())
+
+
 class _Numpy:
     """Stands for ``numpy`` in the generated module: logs ``copyto``, passes the rest."""
 
-    def __init__(self, log: list[tuple[Callable[..., Any], tuple, dict]]):
-        self.log = log
+    def __init__(self, log: list[tuple[Callable[..., Any], tuple, dict]], n: int):
+        self.log, self.n = log, n
 
     def __getattr__(self, name: str) -> Any:
         return getattr(np, name)
 
     def copyto(self, dst: np.ndarray, src: Any) -> None:
-        self.log.append((np.copyto, (("row", dst.dtype), ("row", np.float64)), {}))
+        self.log.append((np.copyto, (kind(dst, self.n), kind(src, self.n)), {}))
         np.copyto(dst, src)
 
 
-def record(module: Any, run: Callable[[], object]) -> list[tuple[Callable[..., Any], tuple, dict]]:
-    """The calls ``run()`` makes through ``module``'s ufuncs and ``numpy.copyto``, in order."""
+def record(
+    module: Any, run: Callable[[], object], n: int
+) -> list[tuple[Callable[..., Any], tuple, dict]]:
+    """The calls ``run()`` makes through ``module``'s ufuncs and ``numpy.copyto``, in order, on
+    a block of ``n`` samples."""
     log: list[tuple[Callable[..., Any], tuple, dict]] = []
     saved = dict(vars(module))
     try:
         for name, value in saved.items():
             if isinstance(value, np.ufunc):
-                setattr(module, name, _Recorder(value, log))
-        module.numpy = _Numpy(log)
+                setattr(module, name, _Recorder(value, log, n))
+        module.numpy = _Numpy(log, n)
         run()
     finally:
         for name, value in saved.items():
@@ -106,20 +116,21 @@ def replay(log: list[tuple[Callable[..., Any], tuple, dict]], block: int) -> Cal
     subnormal, which would change its cost) and their outputs written in turn to as many
     other rows."""
     rng = np.random.default_rng(0)
-    rows: dict[tuple[bool, Any], list[np.ndarray]] = {}
+    rows: dict[tuple[bool, Any, tuple[int, ...]], list[np.ndarray]] = {}
     bound = []
     turn = 0
     for call, kinds, kwargs in log:
         inputs = getattr(call, "nin", 2 if call is np.copyto else len(kinds))
         outputs_first = call is np.copyto
         args = []
-        for k, (kind, what) in enumerate(kinds):
-            if kind == "scalar":
+        for k, (form, what, lead) in enumerate(kinds):
+            if form == "scalar":
                 args.append(what)
                 continue
             written = (k == 0) if outputs_first else (k >= inputs)
-            pool = rows.setdefault((written, what), [(0.5 + rng.random(block)).astype(what)
-                                                     for _ in range(HOT_ROWS)])  # fmt: skip
+            shape = (*lead, block)
+            pool = rows.setdefault((written, what, lead), [(0.5 + rng.random(shape)).astype(what)
+                                                           for _ in range(HOT_ROWS)])  # fmt: skip
             args.append(pool[turn % HOT_ROWS])
             turn += 1
         bound.append((call, tuple(args), kwargs))
@@ -163,7 +174,11 @@ def parts(variant: str, rounds: int) -> dict[str, float]:
 
     first = blocks[0]
     one_block = ev.allocate(info, first.stop)
-    log = record(ev.module, lambda: ev.run(info, params, [x[first] for x in inputs], one_block))
+    log = record(
+        ev.module,
+        lambda: ev.run(info, params, [x[first] for x in inputs], one_block),
+        first.stop - first.start,
+    )
     floor = replay(log, first.stop - first.start)
     kept = ev.allocate(info, N)
 
