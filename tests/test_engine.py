@@ -26,6 +26,9 @@ from rpr3gen.evaluators import evaluator
 ACTUATIONS = ("revolute", "prismatic")
 #: The paper's two variants, by actuation.
 S = {a: structures.from_variant(a) for a in ACTUATIONS}
+#: The registry's functions kept beside the toy one: the toy's variant is rendered in this
+#: process, and the whole registry (the committed variants' functions) takes 14 s.
+KEPT = {name: registry.FUNCTIONS[name] for name in ("inverse_dynamics", "actuator_coordinates")}
 
 
 def leg_lengths(structure: structures.Structure) -> FunctionSpec:
@@ -70,7 +73,7 @@ def leg_lengths(structure: structures.Structure) -> FunctionSpec:
 
 @pytest.fixture(scope="module")
 def toy_folder(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    functions = {**registry.FUNCTIONS, "leg_lengths": leg_lengths}
+    functions = {**KEPT, "leg_lengths": leg_lengths}
     out = tmp_path_factory.mktemp("generated")
     write_files(out, generate.render(tuple(S.values()), functions=functions))
     return out
@@ -101,9 +104,7 @@ def test_a_toy_spec_is_rendered_compiled_and_called_by_name(
 ) -> None:
     assert "leg_lengths" not in registry.FUNCTIONS  # the temporary registry only
     variant = manifest.load(actuation, toy_folder)
-    assert set(variant.functions) == {*registry.FUNCTIONS, "leg_lengths"} - {
-        name for name in registry.FUNCTIONS if registry.FUNCTIONS[name](S[actuation]) is None
-    }
+    assert set(variant.functions) == {*KEPT, "leg_lengths"}
     header = variant.path("c_header").read_text()
     assert "int rpr3_leg_lengths(const double *params, const double q[3], double lengths[3]);" in (
         header

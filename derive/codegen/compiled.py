@@ -43,6 +43,10 @@ class Compiled:
     def input_symbols(self) -> set[sp.Symbol]:
         return {s for arg in self.spec.inputs for s in arg.symbols}
 
+    def param_symbols(self, params: Argument) -> set[sp.Symbol]:
+        """The symbols of ``params`` (the module's, compiled against) that the code reads."""
+        return {params.symbols[k] for k, _ in self.used_params}
+
 
 def compile_function(spec: FunctionSpec, params: Argument) -> Compiled:
     """Eliminate common subexpressions of ``spec`` and record which inputs it reads."""

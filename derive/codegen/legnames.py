@@ -17,7 +17,8 @@ it; the renaming runs to a fixed point. Names change, not values: the expression
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Sequence
+from collections import Counter
+from collections.abc import Iterable, Mapping, Sequence
 from collections.abc import Set as AbstractSet
 
 import sympy as sp
@@ -33,6 +34,23 @@ def leg_family(name: str, known: AbstractSet[str]) -> tuple[str, str] | None:
         if ch == "A" and all(name[:k] + leg + name[k + 1 :] in known for leg in LEGS[1:]):
             return name[:k], name[k + 1 :]
     return None
+
+
+def shape(expr: sp.Expr, family: Mapping[sp.Symbol, object]) -> object:
+    """``expr`` as a hashable tree, each symbol of ``family`` replaced by its family (its
+    pattern, or a group's number): equal for two expressions exactly when they are one
+    expression once those symbols are read as their families, as SymPy's equality would say of
+    the expressions with the symbols so replaced (a sum's or product's terms compared as a
+    multiset, since SymPy orders them by the symbols' names; no two symbols of one expression
+    share a family)."""
+    if expr in family:
+        return ("@", family[expr])
+    if not expr.args:
+        return expr
+    args = [shape(a, family) for a in expr.args]
+    if isinstance(expr, (sp.Add, sp.Mul)):
+        return (expr.func, frozenset(Counter(args).items()))
+    return (expr.func, tuple(args))
 
 
 def _families(names: Iterable[str]) -> dict[str, tuple[str, int]]:
@@ -75,11 +93,11 @@ def leg_names(
     for sym, free in reads.items():
         for s in free:
             readers.setdefault(s, []).append(sym)
-    keyed: dict[sp.Symbol, sp.Expr] = {}  # a temporary's current key (one leg only)
-    index: dict[sp.Expr, dict[int, sp.Symbol]] = {}  # key -> leg -> temporary
+    keyed: dict[sp.Symbol, object] = {}  # a temporary's current key (one leg only)
+    index: dict[object, dict[int, sp.Symbol]] = {}  # key -> leg -> temporary
     dirty = list(pending)
     while dirty:  # each pass looks again only at the readers of what the last one renamed
-        touched: list[sp.Expr] = []
+        touched: list[object] = []
         for sym in dirty:
             old = keyed.pop(sym, None)
             if old is not None:
@@ -87,9 +105,7 @@ def leg_names(
             legs = {leg_of[s][1] for s in reads[sym] if s in leg_of}
             if len(legs) != 1:
                 continue
-            key = pending[sym].xreplace(
-                {s: sp.Symbol("@" + leg_of[s][0]) for s in reads[sym] if s in leg_of}
-            )
+            key = shape(pending[sym], {s: leg_of[s][0] for s in reads[sym] if s in leg_of})
             keyed[sym] = key
             index.setdefault(key, {}).setdefault(legs.pop(), sym)
             touched.append(key)

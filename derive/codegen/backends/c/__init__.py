@@ -106,7 +106,7 @@ def _function(module: ModuleSpec, c: Compiled, values: bool = False) -> dict[str
 
     prefix, spec = module.prefix, c.spec
     upper = prefix.upper()
-    params = {s for s in module.params.symbols if any(str(s) == n for _, n in c.used_params)}
+    params = c.param_symbols(module.params)
     try:
         p = None if spec.c_body else plan(c.code, c.input_symbols, params)
     except NotSplittableError:  # the batch loops over the kernel instead

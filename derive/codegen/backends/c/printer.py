@@ -80,13 +80,18 @@ def _printer(prefix: str, fast: bool) -> CPrinter:
     return CPrinter(prefix, fast)
 
 
-@lru_cache(maxsize=1 << 16)
 def c_code(expr: sp.Expr, prefix: str, fast: bool = False) -> str:
     """One C99 expression; ``fast``: the batch loops' form (see the module docstring).
 
     Memoised: a variant prints most statements several times (the single-sample kernel, the
     values-only kernels, the batch's passes), and printing is a third of its generation time.
-    SymPy's equality is structural, so an equal expression prints the same text."""
+    SymPy's equality is structural, so an equal expression prints the same text. The fast form
+    of an expression without ``sin`` or ``cos`` is its plain form, printed once for both."""
+    return _c_code(expr, prefix, fast and expr.has(sp.sin, sp.cos))
+
+
+@lru_cache(maxsize=1 << 16)
+def _c_code(expr: sp.Expr, prefix: str, fast: bool) -> str:
     return _printer(prefix, fast).doprint(prepare(expr))
 
 

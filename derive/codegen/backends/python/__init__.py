@@ -40,9 +40,7 @@ def render(
             if c.spec.c_body is not None:  # C only: the runtime composes it from the others
                 continue
             inputs = {s: str(s) for arg in c.spec.inputs for s in arg.symbols}
-            params = {
-                s for s in module.params.symbols if any(str(s) == n for _, n in c.used_params)
-            }
+            params = c.param_symbols(module.params)
             rows = {f"{o}[{k}]": f"{o}[{k}]" for o, k in c.slots}
             functions.append(
                 {

@@ -46,7 +46,7 @@ import sympy as sp
 from rpr3gen_derive.codegen.backends.python.printer import numpy_code
 from rpr3gen_derive.codegen.cse import StraightLine
 from rpr3gen_derive.codegen.functions import INV_TWO_PI, TWO_PI, wrap_angle
-from rpr3gen_derive.codegen.legnames import LEGS, leg_family
+from rpr3gen_derive.codegen.legnames import LEGS, leg_family, shape
 
 _UFUNC = {sp.cos: "cos", sp.sin: "sin", sp.Abs: "absolute"}
 
@@ -585,7 +585,8 @@ def leg_groups(
     (:func:`~rpr3gen_derive.codegen.legnames.leg_family`): the legs' parameters, parameter-only
     statements, then, to a fixed point, per-sample statements whose right-hand sides are one
     expression once each member they read is read as its group (the same tree, as SymPy keeps
-    it: the same operations on the same operands). Such statements give each leg the same bits
+    it: the same operations on the same operands; compared by
+    :func:`~rpr3gen_derive.codegen.legnames.shape`). Such statements give each leg the same bits
     as one statement each. None when there are fewer than :data:`MIN_GROUPS` per-sample
     groups."""
     names = {str(x): x for x in scalars} | {str(lhs): lhs for lhs, _ in statements}
@@ -604,24 +605,41 @@ def leg_groups(
             for leg, x in enumerate(per_leg):
                 member[x] = (count, leg, False)
             count += 1
+    # A candidate's key changes only when a symbol it reads joins a group: each pass computes
+    # again the keys of those statements alone (the rest are kept), then collects the keys in
+    # the statements' order, as one pass over them all would.
+    candidates = [
+        (lhs, rhs, rhs.free_symbols)
+        for lhs, rhs in statements
+        if lhs not in member and lhs not in scalar and not isinstance(rhs, (sp.sin, sp.cos))
+    ]
+    keys: dict[sp.Symbol, tuple[sp.Expr, int] | None] = {}
+    joined: set[sp.Symbol] | None = None  # None: every key is to compute
     groups = 0
     while True:
         found: dict[sp.Expr, dict[int, sp.Symbol]] = {}
-        for lhs, rhs in statements:
-            if lhs in member or lhs in scalar or isinstance(rhs, (sp.sin, sp.cos)):
+        for lhs, rhs, free in candidates:
+            if lhs in member:
                 continue
-            read = [x for x in rhs.free_symbols if x in member]
-            legs = {member[x][1] for x in read}
-            if len(legs) != 1:
-                continue
-            key = rhs.xreplace({x: sp.Symbol(f"@{member[x][0]}", real=True) for x in read})
-            found.setdefault(key, {}).setdefault(legs.pop(), lhs)
+            if joined is None or not joined.isdisjoint(free):
+                read = [x for x in free if x in member]
+                legs = {member[x][1] for x in read}
+                keys[lhs] = (
+                    (shape(rhs, {x: member[x][0] for x in read}), legs.pop())
+                    if len(legs) == 1
+                    else None
+                )
+            entry = keys[lhs]
+            if entry is not None:
+                found.setdefault(entry[0], {}).setdefault(entry[1], lhs)
         complete = [t for t in found.values() if len(t) == len(LEGS) and _fits(t, alias)]
         if not complete:
             break
+        joined = set()
         for three in complete:
             for leg, x in three.items():
                 member[x] = (count, leg, True)
+                joined.add(x)
             count += 1
             groups += 1
     return member if groups >= MIN_GROUPS else {}
