@@ -1,7 +1,8 @@
 """Shared fixtures and session set-up: paths of the source tree, one cache of derived variants
 and C builds per session, the long tests first.
 
-The suite runs on every core (``-n auto``, pytest-xdist, in ``pyproject.toml``). Its workers
+The suite runs on every core (``-n auto --dist worksteal``, pytest-xdist, in
+``pyproject.toml``). Its workers
 share one cache of derived variants and C builds, a fresh folder per session unless
 ``RPR3GEN_CACHE_DIR`` is set (then that folder, and it is kept): each structure is derived and
 each variant compiled once per session, by whichever worker needs it first, while the others
@@ -40,7 +41,7 @@ def pytest_unconfigure(config: pytest.Config) -> None:
 @pytest.hookimpl(trylast=True)
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
     """The tests marked ``slow`` first (stable: otherwise in collection order), so that on
-    several workers the long ones start at once rather than end the run on one worker."""
+    several workers none of the long ones is left to end the run on one worker."""
     items.sort(key=lambda item: item.get_closest_marker("slow") is None)
 
 
