@@ -613,11 +613,11 @@ def leg_groups(
         for lhs, rhs in statements
         if lhs not in member and lhs not in scalar and not isinstance(rhs, (sp.sin, sp.cos))
     ]
-    keys: dict[sp.Symbol, tuple[sp.Expr, int] | None] = {}
+    keys: dict[sp.Symbol, tuple[object, int] | None] = {}
     joined: set[sp.Symbol] | None = None  # None: every key is to compute
     groups = 0
     while True:
-        found: dict[sp.Expr, dict[int, sp.Symbol]] = {}
+        found: dict[object, dict[int, sp.Symbol]] = {}
         for lhs, rhs, free in candidates:
             if lhs in member:
                 continue
