@@ -3,7 +3,7 @@
 ``numpy.empty`` of a large array maps fresh pages, and the operating system zeroes each page at
 its first write: for the inverse dynamics' 424 bytes of outputs a sample, 35-47 ns a sample on
 the benchmark machine, a tenth of the NumPy evaluation and a third of the C batch's
-(docs/performance.md). A caller that evaluates again after dropping its last result (a loop
+(docs/performance-log.md). A caller that evaluates again after dropping its last result (a loop
 over trajectories, identification's iterations, a sweep's chunks) can have the same pages back,
 already mapped.
 

@@ -73,7 +73,7 @@ EXTRA_FLAGS: tuple[tuple[str, ...], ...] = (
 #: otherwise compiles on one core, and gcc's register allocation of the large kernels is most
 #: of a build (issue 20: rrr_1's library 17.7 -> 10.7 s, the paper's 10.6 -> 6.8 s and
 #: 11.3 -> 6.3 s on 2 cores). Every function keeps its code's speed (the generated functions
-#: through the library measured the same within 2.5 %, docs/performance.md) and its values:
+#: through the library measured the same within 2.5 %, docs/performance-log.md) and its values:
 #: no flag that changes one is added. A compiler or linker that refuses it builds with
 #: EXTRA_FLAGS alone.
 PARALLEL_FLAGS: tuple[str, ...] = ("-flto=auto", "-flto-partition=balanced")
