@@ -63,7 +63,19 @@ CFLAGS: tuple[str, ...] = (
 #: -falign-functions=64 starts every function on a cache line, so that its speed does not hang
 #: on the size of the code linked before it (issue 20: the same inverse dynamics batch, machine
 #: code unchanged, measured 56 or 66 ns by where it landed); it changes no value.
+#: -mtune=generic keeps -march=native's instruction set but not the tuning it implies: gcc 12's
+#: for the first-generation Zen (znver1) made the generated kernels ~20 % slower than its
+#: generic tuning, or than znver3's, on such a machine (issue 20: the inverse dynamics' single
+#: call 283 -> 225 ns, docs/performance-log.md); it changes no value either. The later sets
+#: are for compilers that refuse -mtune (then -mno-fma), or any of these flags.
 EXTRA_FLAGS: tuple[tuple[str, ...], ...] = (
+    (
+        "-march=native",
+        "-mtune=generic",
+        "-mno-fma",
+        "-fno-tree-slp-vectorize",
+        "-falign-functions=64",
+    ),
     ("-march=native", "-mno-fma", "-fno-tree-slp-vectorize", "-falign-functions=64"),
     ("-march=native", "-fno-tree-slp-vectorize", "-falign-functions=64"),
     (),

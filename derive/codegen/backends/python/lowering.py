@@ -28,7 +28,7 @@ one call each operation on a (3, n) block of three consecutive work rows (``t12`
 14), the legs' parameters as a (3, 1) column; a group is placed where its first statement was,
 after what it reads (:func:`_units`), and each leg's row is freed when that leg's value is dead.
 The inverse dynamics makes ~40 % fewer calls (602 to 370, prismatic): 5 % less time at 10^4
-samples, the same at 10^5 (docs/performance.md). The values are each leg's own, the terms of a
+samples, the same at 10^5 (docs/performance-log.md). The values are each leg's own, the terms of a
 sum possibly in another order (round-off).
 
 Last, each output row is summed into the function's ``sums`` argument right after the last line
