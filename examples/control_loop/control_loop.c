@@ -6,6 +6,7 @@
  * (rpr3_actuator_coordinates) rounded to whole encoder counts: 2^17 counts per revolution
  * (revolute actuation) or 1 um per count (prismatic). Controller, nominal model, every tick:
  *   qa    = counts * resolution;  qa' = (counts - previous counts) * resolution / dt, low-pass
+ *   q_d, qd_d, qdd_d = the reference at t (eq. 3), first: it needs no measurement
  *   q, J  = rpr3_forward_kinematics_jacobian(qa, q_near = 2 q[k-1] - q[k-2])
  *           (tracked; J = d qa / d q at q, which the tracked Newton evaluated there)
  *   q'    : J q' = qa'
@@ -13,8 +14,8 @@
  *   tau   : J^T tau = M (qdd_d + Kd (qd_d - q') + Kp (q_d - q)) + c
  *           (both solves from J's cofactors and 1 / det J, computed once a tick)
  * Prints the tracking error, the pose and velocity estimates' errors, the failed calls and the
- * latency (p50, p99, max) of the forward kinematics, of the rest of the tick (velocity, reference,
- * dynamics, law) and of the whole tick. The ticks alternate between the two measures: an even
+ * latency (p50, p99, max) of the forward kinematics (with the rate filter and the reference
+ * before it), of the rest of the tick (velocity, dynamics, law) and of the whole tick. The ticks alternate between the two measures: an even
  * tick is split at the end of its forward kinematics (a clock read between the parts), an odd
  * tick is timed whole, with no clock read inside it (a read costs ~30 ns, which the whole tick
  * would otherwise carry). The variant (actuation) is the generated folder the program is built
@@ -255,6 +256,11 @@ static void controller_tick(struct controller *ctl, const long *counts, double t
         near[k] = 2.0 * ctl->q1[k] - ctl->q2[k];
     }
     ctl->started = 1;
+    /* the reference (eq. 3: a cos and a sin of t) depends on no measurement: computed before the
+     * forward kinematics, it runs beside that call's chain of dependent operations instead of
+     * after it (the whole tick's p50 ~100 ns lower with revolute actuation on an AMD EPYC;
+     * docs/performance-log.md, fourteenth stop) */
+    reference(ctl->amplitude, t, q_d, qd_d, qdd_d);
 
     /* the pose and J there: tracked forward kinematics from the prediction */
     status = rpr3_forward_kinematics_jacobian(ctl->params, qa, near, q, J);
@@ -276,7 +282,6 @@ static void controller_tick(struct controller *ctl, const long *counts, double t
     }
     solve3(&Jc, ctl->rate, 0, ctl->qd); /* the velocity: J q' = qa' */
 
-    reference(ctl->amplitude, t, q_d, qd_d, qdd_d);
     for (k = 0; k < 3; ++k) {
         acc[k] = qdd_d[k] + KD * (qd_d[k] - ctl->qd[k]) + KP * (q_d[k] - q[k]);
     }

@@ -136,6 +136,9 @@ class Controller:
             self.rate = [r + alpha * ((c - o) * scale - r)
                          for r, c, o in zip(self.rate, counts, old, strict=True)]  # fmt: skip
         self.counts = counts
+        # the reference (eq. 3) needs no measurement: first, as in control_loop.c
+        w = math.pi / DURATION
+        c, s = math.cos(w * t), math.sin(w * t)
         # the pose: tracked forward kinematics from the constant-velocity prediction
         q1, q2 = self.q1, self.q2
         near = (2.0 * q1[0] - q2[0], 2.0 * q1[1] - q2[1], 2.0 * q1[2] - q2[2])
@@ -155,8 +158,6 @@ class Controller:
         else:
             self.qd = qd = vel.qd.tolist()
             # computed torque in task space: tau = J^-T (M (qdd_d + Kd e' + Kp e) + c)
-            w = math.pi / DURATION
-            c, s = math.cos(w * t), math.sin(w * t)
             eff = self.efforts
             eff.qdd[:] = [a * (w * w * c) + KD * (a * (w * s) - v) + KP * (a * (1.0 - c) - x)
                           for a, v, x in zip(self.amplitude, qd, q, strict=True)]  # fmt: skip
