@@ -15,11 +15,12 @@
  *           (both solves from J's cofactors and 1 / det J, computed once a tick)
  * Prints the tracking error, the pose and velocity estimates' errors, the failed calls and the
  * latency (p50, p99, max) of the forward kinematics (with the rate filter and the reference
- * before it), of the rest of the tick (velocity, dynamics, law) and of the whole tick. The ticks alternate between the two measures: an even
- * tick is split at the end of its forward kinematics (a clock read between the parts), an odd
- * tick is timed whole, with no clock read inside it (a read costs ~30 ns, which the whole tick
- * would otherwise carry). The variant (actuation) is the generated folder the program is built
- * with. The arguments are control_loop.py's (but --model and --actuation):
+ * before it), of the rest of the tick (velocity, dynamics, law) and of the whole tick. The
+ * ticks alternate between the two measures: an even tick is split at the end of its forward
+ * kinematics (a clock read between the parts), an odd tick is timed whole, with no clock read
+ * inside it (a read costs ~30 ns, which the whole tick would otherwise carry). The variant
+ * (actuation) is the generated folder the program is built with. The arguments are
+ * control_loop.py's (but --model and --actuation):
  *
  *   make && ./control_loop_revolute [--params FILE] [--trajectory rectilinear|rotation]
  *                                   [--seconds T] [--offset MM] [rectilinear|rotation]
@@ -258,8 +259,8 @@ static void controller_tick(struct controller *ctl, const long *counts, double t
     ctl->started = 1;
     /* the reference (eq. 3: a cos and a sin of t) depends on no measurement: computed before the
      * forward kinematics, it runs beside that call's chain of dependent operations instead of
-     * after it (the whole tick's p50 ~100 ns lower with revolute actuation on an AMD EPYC;
-     * docs/performance-log.md, fourteenth stop) */
+     * after it (the whole tick's p50 ~100 ns lower in most runs with revolute actuation on an
+     * AMD EPYC; docs/performance-log.md, fourteenth stop) */
     reference(ctl->amplitude, t, q_d, qd_d, qdd_d);
 
     /* the pose and J there: tracked forward kinematics from the prediction */
