@@ -428,6 +428,36 @@ def test_jacobian_rate_is_the_derivative_of_the_jacobian_along_the_motion(
 
 @pytest.mark.parametrize("robot", ROBOTS)
 @pytest.mark.parametrize(("actuation", "backend"), _cases())
+def test_actuator_hessian_is_the_derivative_of_the_jacobian(
+    actuation: str, backend: str, robot: str | int
+) -> None:
+    """H = d2 qa / dq2 against central differences of J (h = 1e-6) along each coordinate; H
+    symmetric; H[q', q'] = J' q' (jacobian_rate, another program) and against Newton-Euler's leg
+    accelerations at q'' = 0; qa and J those of actuator_coordinates_jacobian to round-off."""
+    motion = _motion(actuation, robot)
+    model, q, qd = motion.model, motion.q, motion.qd
+    qa, J, H = rpr3gen.actuator_coordinates_hessian(model, q, backend)
+    assert H.shape == (len(q), 3, 3, 3)
+    assert np.array_equal(H, H.transpose(0, 1, 3, 2))
+    h = 1e-6
+    for k in range(3):
+        step = h * np.eye(3)[k]
+        dJ = (
+            rpr3gen.actuator_jacobian(model, q + step, backend)
+            - rpr3gen.actuator_jacobian(model, q - step, backend)
+        ) / (2 * h)
+        assert _relative(H[:, :, :, k], dJ) < 1e-7
+    quadratic = np.einsum("nijk,nj,nk->ni", H, qd, qd)
+    assert _relative(quadratic, rpr3gen.jacobian_rate(model, q, qd, backend)) < 1e-12
+    legs = _leg_values(model, q, qd, np.zeros_like(q))
+    assert _relative(quadratic, legs[ACCELERATION[actuation]]) < 1e-12
+    qa_other, J_other = rpr3gen.actuator_coordinates_jacobian(model, q, backend)
+    assert _relative(qa, qa_other) < 1e-14
+    assert _relative(J, J_other) < 1e-14
+
+
+@pytest.mark.parametrize("robot", ROBOTS)
+@pytest.mark.parametrize(("actuation", "backend"), _cases())
 def test_jacobian_rate_is_the_leg_acceleration_at_rest_platform_acceleration(
     actuation: str, backend: str, robot: str | int
 ) -> None:
@@ -657,6 +687,8 @@ def _evaluate(function: str, motion: Motion, backend: str) -> list[np.ndarray]:
         return [rpr3gen.actuator_jacobian(model, q, backend)]
     if function == "actuator_coordinates_jacobian":
         return list(rpr3gen.actuator_coordinates_jacobian(model, q, backend))
+    if function == "actuator_coordinates_hessian":
+        return list(rpr3gen.actuator_coordinates_hessian(model, q, backend))
     if function == "jacobian_rate":
         return [rpr3gen.jacobian_rate(model, q, qd, backend)]
     if function == "platform_velocity":
@@ -676,6 +708,7 @@ FUNCTIONS = (
     "actuator_coordinates",
     "actuator_jacobian",
     "actuator_coordinates_jacobian",
+    "actuator_coordinates_hessian",
     "jacobian_rate",
     "platform_velocity",
     "task_space_dynamics",

@@ -76,6 +76,7 @@ void last_trace(int out[2])
 FK_KERNELS = (
     "actuator_coordinates",
     "actuator_coordinates_jacobian",
+    "actuator_coordinates_hessian",
     "jacobian_rate",
     "assembly_modes",
     "pose_from_angle",

@@ -611,6 +611,11 @@ def apis(s: Scene) -> tuple[Api, ...]:
             kinds={"model": model_kind, "q": MOTION, "backend": backend},
         ),
         _api(
+            "actuator_coordinates_hessian",
+            good=lambda tmp: {"model": model, "q": q, **on},
+            kinds={"model": model_kind, "q": MOTION, "backend": backend},
+        ),
+        _api(
             "payload_efforts",
             good=lambda tmp: {"model": model, "q": q, **on},
             kinds={"model": model_kind, "q": MOTION, "backend": backend},

@@ -42,6 +42,7 @@ from rpr3gen_derive.planar.structures import Structure, param_names
 
 STEP_JACOBIAN = "actuator Jacobian, d qa / d q, from eq. (6)"
 STEP_RATE = "actuator accelerations at zero platform acceleration, eq. (9)"
+STEP_HESSIAN = "second derivatives of qa by the pose, from eq. (9)"
 STEP_TANGENT = "loads differentiated with respect to the platform acceleration, eqs. (10)-(17)"
 STEP_BIAS = "loads at zero platform acceleration, eqs. (10)-(17)"
 STEP_TASK = "task-space dynamics, M q'' + c = J^T tau"
@@ -116,6 +117,26 @@ def jacobian_rate_term(prog: Program, structure: Structure) -> sp.Matrix:
     so that ``qa'' = J q'' + J' q'``."""
     accelerations = actuator_values(prog, structure, "qdd")
     return sp.Matrix(at_zero(prog, accelerations, list(syms.qdd), "_qdd0", STEP_RATE))
+
+
+#: The index pairs (j, k), j <= k, of the second derivatives d2 qa_i / dq_j dq_k, in order.
+HESSIAN_PAIRS: tuple[tuple[int, int], ...] = UPPER
+
+
+def actuator_hessian(prog: Program, structure: Structure) -> list[list[sp.Expr]]:
+    """``H[i][p] = d2 qa_i / dq_j dq_k`` for the pairs ``(j, k)`` of :data:`HESSIAN_PAIRS`: the
+    actuator coordinates' second derivatives by the pose, one row per leg A, B, C.
+
+    ``J' q' = H[q', q']`` (eq. 9 at zero platform acceleration is a quadratic form in ``q'``),
+    so ``H`` is half the second derivative of :func:`jacobian_rate_term` by ``q'``, which
+    depends on the pose alone: the tracked forward kinematics evaluates it with ``qa`` and ``J``
+    and forms its Chebyshev correction ``H[dq, dq]`` without another kernel on its chain.
+    """
+    rate = jacobian_rate_term(prog, structure)
+    first = differentiate(prog, list(rate), list(syms.qd), STEP_HESSIAN)
+    flat = [first[i][j] for i in range(3) for j in range(3)]
+    second = differentiate(prog, flat, list(syms.qd), STEP_HESSIAN)
+    return [[second[3 * i + j][k] / 2 for j, k in HESSIAN_PAIRS] for i in range(3)]
 
 
 def platform_velocity(prog: Program, structure: Structure) -> sp.Matrix:

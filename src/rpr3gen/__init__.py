@@ -17,6 +17,7 @@ regeneration lives in the package ``rpr3gen_derive`` (folder ``derive/``) and wr
 from rpr3gen.backends import BACKENDS, OUTPUT_NAMES, evaluate, inverse_dynamics
 from rpr3gen.control import (
     actuator_coordinates,
+    actuator_coordinates_hessian,
     actuator_coordinates_jacobian,
     actuator_efforts,
     actuator_jacobian,
@@ -77,6 +78,7 @@ __all__ = [
     "WorkspaceMap",
     "__version__",
     "actuator_coordinates",
+    "actuator_coordinates_hessian",
     "actuator_coordinates_jacobian",
     "actuator_efforts",
     "actuator_jacobian",

@@ -33,6 +33,8 @@ from rpr3gen.validation import Reading, Rows, checked
 
 __all__ = [
     "actuator_coordinates",
+    "actuator_coordinates_hessian",
+    "actuator_coordinates_jacobian",
     "actuator_efforts",
     "actuator_jacobian",
     "assembly_modes",
@@ -44,6 +46,8 @@ __all__ = [
     "task_space_dynamics",
 ]
 
+#: The (j, k) pairs, j <= k, of the generated ``H`` output's 6 entries per leg, in order.
+HESSIAN_PAIRS = ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))
 #: Newton polish of a prismatic mode: converged when every actuator residual is below this (m).
 POLISH_TOL = 1e-11
 #: Newton steps allowed to polish a root of the sextic into a mode.
@@ -87,6 +91,24 @@ def actuator_coordinates_jacobian(
     :func:`actuator_jacobian`'s values to round-off."""
     (qa, J), _ = evaluate(model, "actuator_coordinates_jacobian", (q,), backend)
     return qa, J.reshape(-1, 3, 3)
+
+
+@checked(q=Rows(3))
+def actuator_coordinates_hessian(
+    model: Model, q: ArrayLike, backend: str = "numpy"
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``qa`` (n, 3), ``J = d qa / d q`` (n, 3, 3) and ``H = d2 qa / dq2`` (n, 3, 3, 3,
+    ``H[n, i, j, k] = d2 qa_i / dq_j dq_k``, symmetric in ``j, k``) of each pose in one
+    evaluation (eqs. 5, 6, 9), their common terms computed once: ``J' q' = H[q', q']``
+    (:func:`jacobian_rate`'s values to round-off). The generated function returns the 18
+    entries ``j <= k``; here they are unpacked into the full symmetric tensor."""
+    (qa, J, h), _ = evaluate(model, "actuator_coordinates_hessian", (q,), backend)
+    h = h.reshape(-1, 3, 6)
+    H = np.empty((h.shape[0], 3, 3, 3))
+    for p, (j, k) in enumerate(HESSIAN_PAIRS):
+        H[:, :, j, k] = h[:, :, p]
+        H[:, :, k, j] = h[:, :, p]
+    return qa, J.reshape(-1, 3, 3), H
 
 
 @checked(q=Rows(3), qd=Rows(3), same_length=[("q", "qd")])

@@ -22,6 +22,7 @@ from rpr3gen_derive.planar import direct_kinematics as dk
 from rpr3gen_derive.planar.registry.arguments import params_argument
 from rpr3gen_derive.planar.registry.control_model import (
     actuator_coordinates,
+    actuator_coordinates_hessian,
     actuator_coordinates_jacobian,
     actuator_efforts,
     actuator_jacobian,
@@ -100,6 +101,7 @@ FUNCTIONS: Mapping[str, FunctionBuilder] = {
     "joint_points": joint_points,
     "actuator_jacobian": actuator_jacobian,
     "actuator_coordinates_jacobian": actuator_coordinates_jacobian,
+    "actuator_coordinates_hessian": actuator_coordinates_hessian,
     "jacobian_rate": jacobian_rate,
     "platform_velocity": platform_velocity,
     "actuator_efforts": actuator_efforts,

@@ -97,6 +97,61 @@ def actuator_coordinates_jacobian(structure: Structure) -> FunctionSpec:
     )
 
 
+def hessian_output(structure: Structure, H: list[list[sp.Expr]]) -> Output:
+    """The output ``H``: ``d2 qa_i / dq_j dq_k`` for ``j <= k`` (18 components ``H{i}{j}{k}``,
+    1-based, row by row of ``qa``), the pairs of :data:`control.HESSIAN_PAIRS`."""
+    qa_names = [c.name for c in actuator_argument(structure).components]
+    q_names = [c.name for c in POSE.components]
+    # the unit of qa over those of q_j and q_k (m, m, rad), by how many of j, k are phi
+    units = ("1/m^2", "1/m", "1") if structure.actuated_kind == "R" else ("1/m", "1", "m")
+
+    def unit(j: int, k: int) -> str:
+        return units[(j == 2) + (k == 2)]
+
+    return Output(
+        "H",
+        tuple(H[i][p] for i in range(3) for p in range(len(control.HESSIAN_PAIRS))),
+        tuple(
+            Component(
+                f"H{i + 1}{j + 1}{k + 1}",
+                unit(j, k),
+                f"d2 {qa_names[i]} / d {q_names[j]} d {q_names[k]}",
+            )
+            for i in range(3)
+            for j, k in control.HESSIAN_PAIRS
+        ),
+        "H = d2 qa / dq2, the pairs j <= k of each row i (H[i][k][j] = H[i][j][k])",
+    )
+
+
+def actuator_coordinates_hessian(structure: Structure) -> FunctionSpec:
+    """``rpr3_actuator_coordinates_hessian``: ``qa``, ``J = d qa / d q`` and the second
+    derivatives ``H = d2 qa / dq2`` of a pose in one call (eqs. 5, 6, 9), their common terms
+    evaluated once. ``J' q' = H[q', q']``. The tracked forward kinematics' Newton evaluates it at
+    its start, so that its third-order correction ``H[dq, dq]`` needs no other kernel."""
+    prog = Program()
+    values = sp.Matrix(control.actuator_values(prog, structure, "q"))
+    J = control.actuator_jacobian(prog, structure)
+    H = control.actuator_hessian(prog, structure)
+    qa = actuator_argument(structure)
+    return FunctionSpec(
+        name="actuator_coordinates_hessian",
+        doc=f"Actuator coordinates qa ({qa.doc}) of the platform pose q (eq. 5), the actuator "
+        "Jacobian J = d qa / d q (eq. 6 differentiated, row-major) and the second derivatives "
+        "H = d2 qa / dq2 there (eq. 9: J' q' = H[q', q']), in one call, their common terms "
+        "evaluated once. H has 18 components, H{i}{j}{k} = d2 qa_i / dq_j dq_k for j <= k "
+        "(11, 12, 13, 22, 23, 33 for each leg i).",
+        inputs=(POSE,),
+        outputs=(
+            output_like("qa", values, qa, qa.doc),
+            jacobian_output(structure, J),
+            hessian_output(structure, H),
+        ),
+        program=prog,
+        checks=pose_checks(prog, structure),
+    )
+
+
 def jacobian_rate(structure: Structure) -> FunctionSpec:
     """``rpr3_jacobian_rate``: ``J' q'``, so that ``qa'' = J q'' + J' q'`` (eq. 9)."""
     prog = Program()

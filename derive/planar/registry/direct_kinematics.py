@@ -239,7 +239,11 @@ def forward_kinematics(structure: Structure) -> FunctionSpec:
         checks=(Check("inputs_not_finite", "NOT_FINITE"), Check("custom", "NO_MODE")),
         c_body="forward_kinematics.c.jinja",
         c_kernels=("minmax",),
-        c_values=("actuator_coordinates_jacobian", "jacobian_rate"),
+        c_values=(
+            "actuator_coordinates_jacobian",
+            "actuator_coordinates_hessian",
+            "jacobian_rate",
+        ),
         c_context=(
             ("kind", fk_kind(structure)),
             ("wrap", structure.actuated_kind == "R"),
