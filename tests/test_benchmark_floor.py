@@ -53,6 +53,15 @@ def test_a_call_in_a_loop_over_the_legs_counts_once_per_leg(cbench: ModuleType) 
     assert cbench.kernel_calls(SOURCE, "p") == {"f": {"cos": 1, "sqrt": 4, "atan2": 3}}
 
 
+def test_a_sincos_call_counts_as_a_sin_and_a_cos(cbench: ModuleType) -> None:
+    source = SOURCE.replace(
+        "    const double c = p_cos(params[0]);\n    for",
+        "    double s0, c;\n    p_sincos(params[0], &s0, &c);\n    for",
+    )
+    assert "p_sincos" in source
+    assert cbench.kernel_calls(source, "p")["f"] == {"sin": 1, "cos": 1, "sqrt": 4, "atan2": 3}
+
+
 @pytest.mark.parametrize("variant", ["revolute", "prismatic"])
 def test_the_inverse_dynamics_floor_has_each_legs_calls(
     cbench: ModuleType, repo_root: Path, variant: str
@@ -111,6 +120,22 @@ def test_the_chain_is_the_longest_path_of_latencies(chain: ModuleType) -> None:
     body = chain.kernel_bodies(CHAIN, "p")["g"]
     lat = latencies(add=1.0, mul=10.0, div=100.0, sqrt=1000.0, cos=10000.0)
     assert chain.critical_path(body, lat, "p") == 10000 + 10 + 1 + 10 + 1 + 1000 + 1 + 100 + 1
+
+
+def test_a_sincos_call_takes_the_longer_of_its_two_latencies(chain: ModuleType) -> None:
+    """The pair's values are ready together, after the sine's or the cosine's latency,
+    whichever is longer; what reads either waits for both."""
+    body = chain.kernel_bodies(CHAIN, "p")["g"].replace(
+        "    const double c = p_cos(q[2]);",
+        "    double s, c;\n    p_sincos(q[2], &s, &c);",
+    )
+    assert "p_sincos" in body
+    for sin, cos in ((1.0, 5.0), (7.0, 2.0)):
+        lat = latencies(add=1.0, mul=10.0, div=100.0, sqrt=1000.0, sin=sin, cos=cos)
+        assert (
+            chain.critical_path(body, lat, "p")
+            == max(sin, cos) + 10 + 1 + 10 + 1 + 1000 + 1 + 100 + 1
+        )
 
 
 @pytest.mark.parametrize("op", ["add", "mul", "div", "sqrt", "cos"])

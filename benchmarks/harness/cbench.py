@@ -7,9 +7,9 @@ function or variant adds rows, not code.
 
 The floor of a function is the libm calls that its generated kernel makes after common
 subexpression elimination and nothing else: its ``sin``, ``cos``, ``sqrt``, ``atan2`` (the
-kernels' ``rpr3_sin`` etc. count as the libm call they replace), on arguments formed from the
-sample's first input: a sin and a cos of one argument (gcc merges them into ``sincos``), the
-sqrt of a sum of squares, the atan2 of two components.
+kernels' ``rpr3_sin`` etc. count as the libm call they replace, ``rpr3_sincos`` as a sin and a
+cos), on arguments formed from the sample's first input: a sin and a cos of one argument (gcc
+merges them into ``sincos``), the sqrt of a sum of squares, the atan2 of two components.
 
 The chain floor of a function (:mod:`harness.chain`) is its kernel's longest chain of dependent
 operations, each weighted by its latency as ``benchmarks/c/latency.c`` measures it right after
@@ -58,6 +58,9 @@ def kernel_calls(source: str, prefix: str) -> dict[str, dict[str, int]]:
                 legs, close = 1, None
             for f in LIBM:
                 found[f] += legs * len(re.findall(rf"(?:\b|\b{prefix}_){f}(?:_fast)?\(", line))
+            pairs = len(re.findall(rf"\b{prefix}_sincos(?:_fast)?\(", line))  # a sin and a cos
+            found["sin"] += legs * pairs
+            found["cos"] += legs * pairs
         calls[name] = {f: k for f, k in found.items() if k}
     return calls
 

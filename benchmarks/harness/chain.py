@@ -44,11 +44,13 @@ KERNELS = {
 #: C's arithmetic operators and the latency that stands for each.
 _OPERATIONS: dict[type, str] = {ast.Add: "add", ast.Sub: "add", ast.Mult: "mul", ast.Div: "div"}
 _ASSIGN = re.compile(r"(?:const double )?(\w+)(\[[^\]]*\])? = (.+);$")
-#: Lines of a kernel that define no value and make no chain longer: declarations, the guards'
-#: early returns, and the header of a loop over ``i`` (a lane loop, or the copy of the legs'
-#: parameters into ``params_by_leg``, whose iterations are independent).
+#: Lines of a kernel that define no value and make no chain longer: declarations (of arrays, and
+#: of the sine and cosine that a ``PREFIX_sincos`` call then defines), the guards' early returns,
+#: and the header of a loop over ``i`` (a lane loop, or the copy of the legs' parameters into
+#: ``params_by_leg``, whose iterations are independent).
 _SKIP = re.compile(
-    r"(double \w+\[\d+\];|int i;|\{|\}|return \w+;|if \(!\(.*|for \(i = 0; i < \d+; \+\+i\) \{)"
+    r"(double \w+\[\d+\];|double \w+, \w+;|int i;|\{|\}|return \w+;|if \(!\(.*"
+    r"|for \(i = 0; i < \d+; \+\+i\) \{)"
     r"(\s*/\*.*\*/)?$"
 )
 
@@ -73,6 +75,16 @@ def critical_path(body: str, latency: Mapping[str, float], prefix: str = "rpr3")
     for line in lines:
         text = line.strip()
         if not text or text == LOOP or _SKIP.fullmatch(text):
+            continue
+        pair = re.fullmatch(rf"{prefix}_sincos\((.+), &(\w+), &(\w+)\);", text)
+        if pair is not None:  # sin and cos of one argument, side by side
+            try:
+                start = _finish(ast.parse(pair[1], mode="eval").body, ready, latency, calls)
+            except (SyntaxError, _UnreadError):
+                return None
+            done = start + max(latency["sin"], latency["cos"])
+            ready[pair[2]] = ready[pair[3]] = done
+            longest = max(longest, done)
             continue
         match = _ASSIGN.match(text)
         if match is None:

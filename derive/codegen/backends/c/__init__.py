@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any
 
 import jinja2
 from rpr3gen_derive.codegen import mathkernels
-from rpr3gen_derive.codegen.backends.c import package
+from rpr3gen_derive.codegen.backends.c import package, sincos
 from rpr3gen_derive.codegen.backends.c.batch import NotSplittableError, plan
 from rpr3gen_derive.codegen.backends.c.lanes import lanes, plain
 from rpr3gen_derive.codegen.backends.c.order import Line, schedule
@@ -82,10 +82,11 @@ def _kernel_lines(
     return schedule(lines)
 
 
-def _code(lines: list[Line], param_count: int) -> list[str]:
+def _code(lines: list[Line], param_count: int, prefix: str) -> list[str]:
     """A kernel's statements as C lines: its legs as lane loops (:mod:`.lanes`) when it has
-    enough statements to share them, else one statement after the other."""
-    return lanes(lines, param_count) or plain(lines)
+    enough statements to share them, else one statement after the other; a sine and a cosine
+    of one argument as one call (:mod:`.sincos`)."""
+    return sincos.pair(lanes(lines, param_count) or plain(lines), prefix)
 
 
 def _needed(lines: list[Line]) -> list[Line]:
@@ -167,12 +168,15 @@ def _function(module: ModuleSpec, c: Compiled, values: bool = False) -> dict[str
         "used_inputs": c.used_inputs,
         "assignments": _lines(c.code.assignments, prefix),
         "kernel_lines": _code(
-            _kernel_lines(c, prefix, outputs(enumerate(e for _, e in c.code.outputs))), count
+            _kernel_lines(c, prefix, outputs(enumerate(e for _, e in c.code.outputs))),
+            count,
+            prefix,
         ),
         "values_lines": (
             _code(
                 _kernel_lines(c, prefix, outputs(enumerate(e for _, e in c.code.outputs)), True),
                 count,
+                prefix,
             )
             if values
             else None
