@@ -48,9 +48,10 @@ def header(r: dict[str, Any]) -> str:
         " ".join(f"{x:.2f}" for x in r["load_end"]),
     )
     kind = "quick" if r["quick"] else "full"
+    cpu = m["cpu"] + (f" ({m['cpu_id']})" if m.get("cpu_id") else "")  # runs before 2026-11-28
     return (f"`python benchmarks/run.py`, {m['date']}, git {m['commit']} "
             f"({kind}, {r['seconds']} s): "
-            f"{m['cpu']}, {m['cores']} logical cores ({m['usable_cores']} usable), {m['cc']}, "
+            f"{cpu}, {m['cores']} logical cores ({m['usable_cores']} usable), {m['cc']}, "
             f"Python {m['python']}, NumPy {m['numpy']}, pyperf {m['pyperf']}; load average "
             f"{load[0]} at the start, {load[1]} at the end.\n")  # fmt: skip
 

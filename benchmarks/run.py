@@ -69,8 +69,7 @@ def log(message: str) -> None:
 def machine() -> dict[str, Any]:
     """CPU, cores, memory, versions and commit: what a figure depends on."""
     info = Path("/proc/cpuinfo").read_text() if Path("/proc/cpuinfo").exists() else ""
-    cpu = next((line.split(":", 1)[1].strip() for line in info.splitlines()
-                if line.startswith("model name")), platform.processor())  # fmt: skip
+    cpu = cpu_fields(info).get("model name", platform.processor())
     cc = subprocess.run([*cbench.CC, "--version"], capture_output=True, text=True, check=False)
     git = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=REPO,
                          capture_output=True, text=True, check=False)  # fmt: skip
@@ -78,6 +77,7 @@ def machine() -> dict[str, Any]:
                            cwd=REPO, capture_output=True, text=True, check=False)  # fmt: skip
     return {
         "cpu": cpu,
+        "cpu_id": cpu_id(info),
         "cores": os.cpu_count(),
         "usable_cores": len(os.sched_getaffinity(0)),
         "python": platform.python_version(),
@@ -87,6 +87,33 @@ def machine() -> dict[str, Any]:
         "commit": git.stdout.strip() + (" (modified)" if dirty.stdout.strip() else ""),
         "date": datetime.now(UTC).strftime("%Y-%m-%d %H:%M UTC"),
     }
+
+
+def cpu_fields(cpuinfo: str) -> dict[str, str]:
+    """The first processor's ``key: value`` lines of ``/proc/cpuinfo``."""
+    fields: dict[str, str] = {}
+    for line in cpuinfo.splitlines():
+        if not line.strip():
+            break
+        key, _, value = line.partition(":")
+        fields[key.strip()] = value.strip()
+    return fields
+
+
+def cpu_id(cpuinfo: str) -> str:
+    """What tells one CPU from another of the same ``model name`` (the benchmark machine has been
+    a Zen 3, a first-generation Zen and a Zen 4, all "AMD EPYC"): family, model, clock and the
+    widest vector instructions, e.g. ``"family 25 model 17, 2596 MHz, AVX-512"``; "" off Linux."""
+    fields = cpu_fields(cpuinfo)
+    if "cpu family" not in fields:
+        return ""
+    flags = set(fields.get("flags", "").split())
+    vector = next((name for flag, name in (("avx512f", "AVX-512"), ("avx2", "AVX2"),
+                                          ("avx", "AVX"), ("sse2", "SSE2")) if flag in flags),
+                  "no SIMD")  # fmt: skip
+    mhz = fields.get("cpu MHz", "")
+    clock = f", {float(mhz):.0f} MHz" if mhz else ""
+    return f"family {fields['cpu family']} model {fields.get('model', '?')}{clock}, {vector}"
 
 
 def run_pyperf(

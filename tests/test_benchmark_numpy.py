@@ -113,3 +113,44 @@ def test_the_report_takes_each_sides_best_round_and_the_median_ratio(repo_root: 
     assert ne == pytest.approx(50e-3 / n * 1e9)  # the best Newton-Euler round
     assert within == pytest.approx(np.median([15.0, 30.0, 10.0]))  # the rounds' own ratios
     assert report.ne_ratios(r, "prismatic") == []
+
+
+CPUINFO = """processor\t: 0
+vendor_id\t: AuthenticAMD
+cpu family\t: {family}
+model\t\t: {model}
+model name\t: AMD EPYC
+cpu MHz\t\t: 2596.144
+flags\t\t: fpu sse2 avx {flags}
+
+processor\t: 1
+cpu family\t: 99
+"""
+
+
+@pytest.mark.parametrize(
+    ("family", "model", "flags", "expected"),
+    [
+        (25, 17, "avx2 avx512f", "family 25 model 17, 2596 MHz, AVX-512"),
+        (23, 1, "avx2", "family 23 model 1, 2596 MHz, AVX2"),
+        (25, 1, "", "family 25 model 1, 2596 MHz, AVX"),
+    ],
+)
+def test_the_report_tells_cpus_of_one_model_name_apart(
+    repo_root: Path, family: int, model: int, flags: str, expected: str
+) -> None:
+    run = harness(repo_root, "run")
+    report = harness(repo_root, "report")
+    info = CPUINFO.format(family=family, model=model, flags=flags)
+    assert run.cpu_id(info) == expected
+    r = {"machine": {"cpu": "AMD EPYC", "cpu_id": expected, "cores": 2, "usable_cores": 2,
+                     "cc": "cc", "python": "3.11", "numpy": "2", "pyperf": "2", "commit": "x",
+                     "date": "d"}, "quick": False, "seconds": 1,
+         "load_start": [0, 0, 0], "load_end": [0, 0, 0]}  # fmt: skip
+    assert f"AMD EPYC ({expected}), 2 logical cores" in report.header(r)
+    del r["machine"]["cpu_id"]  # a run from before the field
+    assert "AMD EPYC, 2 logical cores" in report.header(r)
+
+
+def test_no_cpu_id_without_a_family(repo_root: Path) -> None:
+    assert harness(repo_root, "run").cpu_id("model name\t: Apple M2\n") == ""
