@@ -64,30 +64,18 @@ CFLAGS: tuple[str, ...] = (
 #: on the size of the code linked before it (issue 20: the same inverse dynamics batch, machine
 #: code unchanged, measured 56 or 66 ns by where it landed); it changes no value.
 #: -falign-loops=32 does the same for the loops inside a function: on a Zen 4 the prismatic
-#: inverse dynamics' batch measured 66 ns a sample without it and 57 ns with it, machine code
-#: otherwise unchanged, and no function slower (docs/performance-log.md, sixteenth stop).
+#: inverse dynamics' batch measured 66 ns a sample without it and 57 ns with it, and no function
+#: slower (docs/performance-log.md, sixteenth stop); alignment changes no value either.
 #: -mtune=generic keeps -march=native's instruction set but not the tuning it implies: gcc 12's
 #: for the first-generation Zen (znver1) made the generated kernels ~20 % slower than its
 #: generic tuning, or than znver3's, on such a machine (issue 20: the inverse dynamics' single
 #: call 283 -> 225 ns, docs/performance-log.md); it changes no value either. The later sets
 #: are for compilers that refuse -mtune (then -mno-fma), or any of these flags.
+_ALIGN = ("-falign-functions=64", "-falign-loops=32")
 EXTRA_FLAGS: tuple[tuple[str, ...], ...] = (
-    (
-        "-march=native",
-        "-mtune=generic",
-        "-mno-fma",
-        "-fno-tree-slp-vectorize",
-        "-falign-functions=64",
-        "-falign-loops=32",
-    ),
-    (
-        "-march=native",
-        "-mno-fma",
-        "-fno-tree-slp-vectorize",
-        "-falign-functions=64",
-        "-falign-loops=32",
-    ),
-    ("-march=native", "-fno-tree-slp-vectorize", "-falign-functions=64", "-falign-loops=32"),
+    ("-march=native", "-mtune=generic", "-mno-fma", "-fno-tree-slp-vectorize", *_ALIGN),
+    ("-march=native", "-mno-fma", "-fno-tree-slp-vectorize", *_ALIGN),
+    ("-march=native", "-fno-tree-slp-vectorize", *_ALIGN),
     (),
 )
 #: Tried first, with the first set of EXTRA_FLAGS: link-time optimisation in partitions
