@@ -198,3 +198,25 @@ def test_add_subdirectory_without_installing(repo_root: Path, tmp_path: Path) ->
     assert "RPR3GEN_REVOLUTE_INSTALL:BOOL=OFF" in cache  # a subproject installs nothing itself
     stdout = _run([tmp_path / "build" / "consumer"], stdin=_params("revolute"))
     assert _check(stdout, "revolute", repo_root) == []
+
+
+@pytest.mark.parametrize(
+    ("path", "start", "end"),
+    [
+        ("examples/control_loop/Makefile", "CFLAGS ?=", "VARIANTS ="),
+        ("generated/revolute/CMakeLists.txt", "PRIVATE -fno-math-errno", "endif()"),
+    ],
+)
+def test_every_speed_build_takes_the_runtimes_flags(
+    repo_root: Path, path: str, start: str, end: str
+) -> None:
+    """The example's Makefile and the C package's NATIVE option repeat the runtime's flags
+    (``rpr3gen.cbackend``: its first set, then the two it always passes that change no value);
+    a flag added to one place only would make their timings differ from the runtime's."""
+    from rpr3gen import cbackend
+
+    text = (repo_root / path).read_text()
+    block = text[text.index(start) : text.index(end, text.index(start))]
+    flags = set(block.replace("\\", " ").replace(")", " ").split())
+    wanted = {*cbackend.EXTRA_FLAGS[0], "-fno-math-errno", "-fno-trapping-math"}
+    assert wanted <= flags, sorted(wanted - flags)
