@@ -162,7 +162,7 @@ def test_cse_reduces_the_operation_count(repo_root: Path) -> None:
 def test_source_hash_follows_the_sources(tmp_path: Path) -> None:
     copy = tmp_path / "derive"
     shutil.copytree(generate.ROBOT_DIR.parent, copy, ignore=shutil.ignore_patterns("__pycache__"))
-    roots = (copy / "codegen", copy / "planar")
+    roots = (copy / "codegen", copy / "planar", copy / "spatial")
     original = files.source_hash(roots)
     assert original == generate.source_hash()
     frames = copy / "planar" / "legs.py"

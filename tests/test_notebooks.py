@@ -21,6 +21,7 @@ def test_the_notebooks_are_there() -> None:
     expected = {
         "derivation.ipynb",
         "derivation-rrr.ipynb",
+        "derivation-spatial.ipynb",
         "simulation.ipynb",
         "identification.ipynb",
     }

@@ -15,6 +15,7 @@ from rpr3gen_derive.codegen.files import source_hash
 ROOTS: tuple[Path, ...] = (
     Path(__file__).resolve().parent.parent / "codegen",
     Path(__file__).resolve().parent,
+    Path(__file__).resolve().parent.parent / "spatial",
 )
 
 

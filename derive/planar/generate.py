@@ -16,13 +16,42 @@ from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 from rpr3gen_derive.codegen.render import Generator, Stage, no_stage
-from rpr3gen_derive.planar.registry import FunctionBuilder, module
+from rpr3gen_derive.codegen.spec import ModuleSpec
+from rpr3gen_derive.planar import registry
+from rpr3gen_derive.planar.registry import FunctionBuilder
 from rpr3gen_derive.planar.structures import PAPER, Structure
+from rpr3gen_derive.spatial import registry as spatial_registry
+from rpr3gen_derive.spatial.structures import LEG_TYPES as SPATIAL_LEG_TYPES
+from rpr3gen_derive.spatial.structures import SpatialStructure
 
 ROBOT_DIR = Path(__file__).resolve().parent
+SPATIAL_DIR = ROBOT_DIR.parent / "spatial"
 
-#: The variants committed in ``generated/``: the paper's two and the 3-RRR with base motors.
-COMMITTED: tuple[Structure, ...] = (*PAPER, Structure("RRR", 1))
+#: The variants committed in ``generated/``: the paper's two, the 3-RRR with base motors, the
+#: 6-UPS hexapod and the Delta.
+COMMITTED: tuple[Structure | SpatialStructure, ...] = (
+    *PAPER,
+    Structure("RRR", 1),
+    SpatialStructure("UPS", 2),
+    SpatialStructure("RSS2", 1),
+)
+
+
+def structure_of(leg: str, actuated: int, paper: bool = False) -> Structure | SpatialStructure:
+    """The derivation's structure of a leg type and actuated joint, planar or spatial."""
+    if leg in SPATIAL_LEG_TYPES:
+        return SpatialStructure(leg, actuated)
+    return Structure(leg, actuated, paper)
+
+
+def module(
+    structure: Structure | SpatialStructure, functions: Mapping[str, FunctionBuilder] | None = None
+) -> ModuleSpec:
+    """The generated module of a planar or spatial structure."""
+    if isinstance(structure, SpatialStructure):
+        return spatial_registry.module(structure, functions)  # type: ignore[arg-type]
+    return registry.module(structure, functions)
+
 
 PACKAGE_DOC = """Generated code of rpr3gen, one folder per variant (a leg type, its actuated joint).
 
@@ -35,18 +64,18 @@ function's signature, name tables, thresholds and return codes for the runtime.
 def generator(stage: Stage = no_stage) -> Generator:
     """The engine, set up for this derivation's sources."""
     return Generator(
-        hash_roots=(ROBOT_DIR,),
+        hash_roots=(ROBOT_DIR, SPATIAL_DIR),
         package_doc=PACKAGE_DOC,
         stage=stage,
-        template_dirs=(ROBOT_DIR / "templates",),
+        template_dirs=(ROBOT_DIR / "templates", SPATIAL_DIR / "templates"),
     )
 
 
 def render(
-    structures: Iterable[Structure] = COMMITTED,
+    structures: Iterable[Structure | SpatialStructure] = COMMITTED,
     functions: Mapping[str, FunctionBuilder] | None = None,
     stage: Stage = no_stage,
-    package: Iterable[Structure] | None = None,
+    package: Iterable[Structure | SpatialStructure] | None = None,
 ) -> dict[str, str]:
     """Every generated file for ``structures``, ``{relative path: text}``.
 
@@ -72,10 +101,10 @@ def render(
 
 
 def _render(
-    structures: tuple[Structure, ...],
+    structures: tuple[Structure | SpatialStructure, ...],
     functions: Mapping[str, FunctionBuilder] | None,
     stage: Stage,
-    listed: tuple[Structure, ...],
+    listed: tuple[Structure | SpatialStructure, ...],
 ) -> dict[str, str]:
     """:func:`render` in this process, one structure after the other."""
     gen = generator(stage)
@@ -86,7 +115,9 @@ def _render(
     return gen.render(modules, variants=tuple(s.variant for s in listed))
 
 
-def _render_one(structure: Structure, listed: tuple[Structure, ...]) -> dict[str, str]:
+def _render_one(
+    structure: Structure | SpatialStructure, listed: tuple[Structure | SpatialStructure, ...]
+) -> dict[str, str]:
     return _render((structure,), None, no_stage, listed)
 
 

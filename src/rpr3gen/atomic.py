@@ -125,10 +125,12 @@ def write_results_csv(
     q: np.ndarray,
     outputs: Mapping[str, np.ndarray],
     names: Sequence[str],
+    pose: Sequence[str] = ("x", "y", "phi"),
 ) -> None:
     """Write simulation results as CSV, atomically.
 
-    Columns are ``t,x,y,phi`` and then ``names`` in the given order; every value is written with
+    Columns are ``t``, the ``pose`` (``x,y,phi``) and then ``names`` in the given order; every
+    value is written with
     ``%.17g``, which reads back bit-for-bit (``nan`` marks a failed sample).
 
     Args:
@@ -147,11 +149,11 @@ def write_results_csv(
     if t.ndim != 1:
         raise InputError(f"t must have shape (n,), got {t.shape}")
     n = t.size
-    if q.shape != (n, 3):
-        raise InputError(f"q must have shape ({n}, 3), got {q.shape}")
+    if q.shape != (n, len(pose)):
+        raise InputError(f"q must have shape ({n}, {len(pose)}), got {q.shape}")
     if len(set(names)) != len(names):
         raise InputError("names must not repeat")
-    columns = [t, q[:, 0], q[:, 1], q[:, 2]]
+    columns = [t, *(q[:, k] for k in range(len(pose)))]
     for name in names:
         if name not in outputs:
             raise InputError(f"no output named {name!r}")
@@ -159,7 +161,7 @@ def write_results_csv(
         if value.shape not in ((n,), ()):
             raise InputError(f"output {name!r} must have shape ({n},), got {value.shape}")
         columns.append(np.broadcast_to(value, (n,)))
-    write_csv_table(path, ["t", "x", "y", "phi", *names], np.column_stack(columns))
+    write_csv_table(path, ["t", *pose, *names], np.column_stack(columns))
 
 
 def write_csv_table(path: str | os.PathLike[str], header: Sequence[str], table: np.ndarray) -> None:

@@ -20,7 +20,16 @@ from rpr3gen import failures, manifest, sizes, variants
 from rpr3gen.errors import InputError, InputTypeError
 from rpr3gen.evaluators import BACKENDS, NumpyEvaluator, evaluator, thread_count
 from rpr3gen.model import Model
-from rpr3gen.validation import Check, Instance, Rows, check_same_length, checked, describe
+from rpr3gen.validation import (
+    Check,
+    Instance,
+    PoseRows,
+    Rows,
+    check_same_length,
+    checked,
+    describe,
+    match_width,
+)
 
 __all__ = ["BACKENDS", "OUTPUT_NAMES", "evaluate", "inverse_dynamics", "output_names"]
 
@@ -147,7 +156,9 @@ def evaluate(
         ins, outs = [a[block] for a in arrays], [o[block] for o in outputs]
         failed = ev.run(info, params, ins, outs, count)
         if failed != 0:  # unknown (NumPy could not tell), or some failed: find them in cache
-            codes[block] = failures.apply(info, ins, outs, applied=ev.applies_checks)
+            # a C-only function's NumPy composition (rpr3gen.composed) writes NaN rows as the C
+            applied = ev.applies_checks or info.numpy_function is None
+            codes[block] = failures.apply(info, ins, outs, applied=applied)
     public = [o for o, arg in zip(outputs, info.outputs, strict=True) if not arg.hidden]
     return public, codes
 
@@ -159,7 +170,7 @@ def output_names(model: Model) -> tuple[str, ...]:
     return info.outputs[0].names
 
 
-@checked(q=Rows(3), qd=Rows(3), qdd=Rows(3), same_length=[("q", "qd", "qdd")])
+@checked(q=PoseRows(), qd=PoseRows(), qdd=PoseRows(), same_length=[("q", "qd", "qdd")])
 def inverse_dynamics(
     model: Model,
     q: ArrayLike,
@@ -172,10 +183,12 @@ def inverse_dynamics(
     """Leg kinematics, actuator loads and every joint load for n platform samples.
 
     Args:
-        model: the robot (:func:`rpr3gen.load_model`); its ``actuation`` picks the variant.
-        q: (n, 3) platform pose (x, y, phi) of the centre G, in m, m, rad (eq. 3 or a file).
-        qd: (n, 3) velocity (dx, dy, dphi).
-        qdd: (n, 3) acceleration (ddx, ddy, ddphi).
+        model: the robot (:func:`rpr3gen.load_model`); its structure picks the variant.
+        q: (n, 3) platform pose (x, y, phi) of the centre G, in m, m, rad (eq. 3 or a file);
+            a spatial robot's (docs/spatial-robots.md): (n, 6) ``(x, y, z, a, b, c)`` for a
+            hexapod, (n, 3) ``(x, y, z)`` for a Delta.
+        qd: (n, 3) velocity (dx, dy, dphi), or the spatial pose's rates.
+        qdd: (n, 3) acceleration (ddx, ddy, ddphi), or the spatial pose's accelerations.
         backend: ``"numpy"`` (generated NumPy) or ``"c"`` (generated C, compiled on first use
             and cached; see :mod:`rpr3gen.cbackend`).
         progress: show a progress bar on stderr when it is a terminal (long trajectories).
@@ -189,6 +202,8 @@ def inverse_dynamics(
         is raised, so callers decide (``rpr3gen simulate`` refuses such a trajectory). The
         arrays are views of one block (strided with ``"c"``).
     """
+    arrays = {"q": np.asarray(q), "qd": np.asarray(qd), "qdd": np.asarray(qdd)}
+    match_width(model.structure.dof, model.structure.title, **arrays)
     (out,), _ = evaluate(model, "inverse_dynamics", (q, qd, qdd), backend, progress, threads)
     names = variants.load(model.structure, model.generated).function("inverse_dynamics")
     return dict(zip(names.outputs[0].names, out.T, strict=True))

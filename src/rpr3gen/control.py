@@ -29,7 +29,7 @@ from numpy.typing import ArrayLike
 
 from rpr3gen.backends import evaluate
 from rpr3gen.model import LEGS, Model
-from rpr3gen.validation import Reading, Rows, checked
+from rpr3gen.validation import Instance, PoseRows, Reading, Rows, checked, match_width
 
 __all__ = [
     "actuator_coordinates",
@@ -68,29 +68,40 @@ def platform_radius(model: Model) -> float:
     return math.sqrt(sum(p[x] ** 2 + p[y] ** 2 for x, y in names) / 3)
 
 
-@checked(q=Rows(3))
+def _width(model: Model, **arrays: np.ndarray) -> int:
+    """The model's pose width (3 or 6), the arrays checked against it."""
+    match_width(model.structure.dof, model.structure.title, **arrays)
+    return model.structure.dof
+
+
+@checked(q=PoseRows())
 def actuator_coordinates(model: Model, q: ArrayLike, backend: str = "numpy") -> np.ndarray:
-    """``qa`` of each pose, (n, 3): the actuator part of the inverse kinematics (eq. 5)."""
+    """``qa`` of each pose, (n, 3): the actuator part of the inverse kinematics (eq. 5); a
+    spatial robot's (n, 6) or (n, 3) (docs/spatial-robots.md)."""
+    _width(model, q=np.asarray(q))
     (qa,), _ = evaluate(model, "actuator_coordinates", (q,), backend)
     return qa
 
 
-@checked(q=Rows(3))
+@checked(q=PoseRows())
 def actuator_jacobian(model: Model, q: ArrayLike, backend: str = "numpy") -> np.ndarray:
-    """``J = d qa / d q``, (n, 3, 3), so that ``qa' = J q'`` (eq. 6 differentiated)."""
+    """``J = d qa / d q``, (n, 3, 3), so that ``qa' = J q'`` (eq. 6 differentiated); a
+    hexapod's (n, 6, 6)."""
+    k = _width(model, q=np.asarray(q))
     (J,), _ = evaluate(model, "actuator_jacobian", (q,), backend)
-    return J.reshape(-1, 3, 3)
+    return J.reshape(-1, k, k)
 
 
-@checked(q=Rows(3))
+@checked(q=PoseRows())
 def actuator_coordinates_jacobian(
     model: Model, q: ArrayLike, backend: str = "numpy"
 ) -> tuple[np.ndarray, np.ndarray]:
     """``qa`` (n, 3) and ``J = d qa / d q`` (n, 3, 3) of each pose in one evaluation (eqs. 5,
     6), their common terms computed once: :func:`actuator_coordinates`' and
     :func:`actuator_jacobian`'s values to round-off."""
+    k = _width(model, q=np.asarray(q))
     (qa, J), _ = evaluate(model, "actuator_coordinates_jacobian", (q,), backend)
-    return qa, J.reshape(-1, 3, 3)
+    return qa, J.reshape(-1, k, k)
 
 
 @checked(q=Rows(3))
@@ -128,18 +139,19 @@ def platform_velocity(
     return qd
 
 
-@checked(q=Rows(3), qd=Rows(3), qdd=Rows(3), same_length=[("q", "qd", "qdd")])
+@checked(q=PoseRows(), qd=PoseRows(), qdd=PoseRows(), same_length=[("q", "qd", "qdd")])
 def actuator_efforts(
     model: Model, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, backend: str = "numpy"
 ) -> np.ndarray:
     """The actuator efforts (n, 3) for the platform motion (q, q', q''): the inverse dynamics'
     actuator loads alone, which is ``tau = J^-T (M q'' + c)``, the task-space computed-torque
     law's efforts for a commanded acceleration ``q''``."""
+    _width(model, q=np.asarray(q), qd=np.asarray(qd), qdd=np.asarray(qdd))
     (tau,), _ = evaluate(model, "actuator_efforts", (q, qd, qdd), backend)
     return tau
 
 
-@checked(q=Rows(3), qd=Rows(3), same_length=[("q", "qd")])
+@checked(q=PoseRows(), qd=PoseRows(), same_length=[("q", "qd")])
 def task_space_dynamics(
     model: Model, q: ArrayLike, qd: ArrayLike, backend: str = "numpy"
 ) -> tuple[np.ndarray, np.ndarray]:
@@ -148,15 +160,17 @@ def task_space_dynamics(
     ``M`` is symmetric positive definite (platform coordinates: kg, kg m, kg m^2); ``c`` holds
     the Coriolis and centripetal terms, gravity and the payload (N, N, N m).
     """
+    k = _width(model, q=np.asarray(q), qd=np.asarray(qd))
     (M, c), _ = evaluate(model, "task_space_dynamics", (q, qd), backend)
-    return M.reshape(-1, 3, 3), c
+    return M.reshape(-1, k, k), c
 
 
-@checked(q=Rows(3), qd=Rows(3), tau=Rows(3), same_length=[("q", "qd", "tau")])
+@checked(q=PoseRows(), qd=PoseRows(), tau=PoseRows(), same_length=[("q", "qd", "tau")])
 def forward_dynamics(
     model: Model, q: ArrayLike, qd: ArrayLike, tau: ArrayLike, backend: str = "numpy"
 ) -> np.ndarray:
     """``q'' = M^-1 (J^T tau - c)``, (n, 3): the platform's acceleration under the efforts."""
+    _width(model, q=np.asarray(q), qd=np.asarray(qd), tau=np.asarray(tau))
     (qdd,), _ = evaluate(model, "forward_dynamics", (q, qd, tau), backend)
     return qdd
 
@@ -222,7 +236,7 @@ def _distinct(model: Model, modes: np.ndarray) -> np.ndarray:
     return np.array(kept).reshape(-1, 3)
 
 
-@checked(qa=Reading(3))
+@checked(qa=Instance(object, "an array of actuator coordinates"))
 def assembly_modes(model: Model, qa: ArrayLike, backend: str = "numpy") -> np.ndarray:
     """Every assembly mode of the actuator coordinates ``qa`` (3,): (k, 3) poses, ``phi`` in
     ``(-pi, pi]``, sorted by ``phi``.
@@ -235,7 +249,11 @@ def assembly_modes(model: Model, qa: ArrayLike, backend: str = "numpy") -> np.nd
     ``conditioning`` above ``MIN_CONDITIONING`` (a mode at a parallel singularity, a double one,
     is refused as :func:`rpr3gen.inverse_dynamics` refuses it); joint limits are not applied.
     """
-    row = np.asarray(qa)  # (3,) float64: checked
+    if model.structure.spatial:
+        from rpr3gen.spatial_modes import assembly_modes as spatial_modes
+
+        return spatial_modes(model, Reading(model.structure.dof, finite=True)("qa", qa), backend)
+    row = Reading(3)("qa", qa)
     if model.structure.hold != "circle":
         (modes, margins), _ = evaluate(model, "assembly_modes", (row,), backend)
         # A candidate is a mode where every leg is in its working mode: Newton, from an exact
@@ -260,7 +278,7 @@ def assembly_modes(model: Model, qa: ArrayLike, backend: str = "numpy") -> np.nd
     return modes[np.isfinite(actuator_coordinates(model, modes, backend)).all(axis=1)]
 
 
-@checked(qa=Rows(3), near=Rows(3), same_length=[("qa", "near")])
+@checked(qa=PoseRows(), near=PoseRows(), same_length=[("qa", "near")])
 def forward_kinematics(
     model: Model, qa: ArrayLike, near: ArrayLike, backend: str = "numpy"
 ) -> np.ndarray:
@@ -271,9 +289,14 @@ def forward_kinematics(
     ``backend="c"``: the generated C (damped Newton from ``near`` with the generated Jacobian, and
     every mode as a fallback; fast, for control loops). ``"numpy"``: every mode
     (:func:`assembly_modes`), then the nearest.
+
+    A spatial robot (docs/spatial-robots.md), both backends: the pose Newton reaches from
+    ``near`` (the step halved until the largest residual decreases; NaN when it does not
+    converge), (n, 6) or (n, 3).
     """
     qa, near = np.asarray(qa), np.asarray(near)  # (n, 3) float64 each: checked
-    if backend == "c":
+    _width(model, qa=qa, near=near)
+    if backend == "c" or model.structure.spatial:
         (q,), _ = evaluate(model, "forward_kinematics", (qa, near), backend)
         return q
     rho = platform_radius(model)

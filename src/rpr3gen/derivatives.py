@@ -62,7 +62,12 @@ def check_smoothing(smoothing: object) -> float:
 
 
 def differentiate(
-    t: np.ndarray, q: np.ndarray, smoothing: float = 0.0, *, source: str = "positions"
+    t: np.ndarray,
+    q: np.ndarray,
+    smoothing: float = 0.0,
+    *,
+    source: str = "positions",
+    names: tuple[str, ...] = _POSITION_NAMES,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Positions, velocities and accelerations of the quintic smoothing spline through ``q``.
 
@@ -95,7 +100,7 @@ def differentiate(
             "(a quintic spline), or give the velocity and acceleration columns"
         )
     fitted, qd, qdd = np.empty_like(q), np.empty_like(q), np.empty_like(q)
-    for j, name in enumerate(_POSITION_NAMES):
+    for j, name in enumerate(names):
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             spline = make_splrep(t, q[:, j], k=SPLINE_DEGREE, s=n * smoothing**2)
@@ -118,7 +123,13 @@ def differentiate(
     return (q.copy() if smoothing == 0.0 else fitted), qd, qdd
 
 
-def mismatch(t: np.ndarray, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> str | None:
+def mismatch(
+    t: np.ndarray,
+    q: np.ndarray,
+    qd: np.ndarray,
+    qdd: np.ndarray,
+    names: tuple[str, ...] = _POSITION_NAMES,
+) -> str | None:
     """Say where given velocities and accelerations disagree with the positions, if they do.
 
     The velocities are integrated from the first sample by the trapezoid rule corrected with the
@@ -147,10 +158,11 @@ def mismatch(t: np.ndarray, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> s
             ("dd", qd, qdd, h / 2 * (qdd[1:] + qdd[:-1])),
         )
         for prefix, given, rate, steps in integrals:
-            integral = given[0] + np.concatenate([np.zeros((1, 3)), np.cumsum(steps, axis=0)])
+            zero = np.zeros((1, given.shape[1]))
+            integral = given[0] + np.concatenate([zero, np.cumsum(steps, axis=0)])
             deviation = np.nan_to_num(np.abs(integral - given), nan=np.inf)
             scale = np.maximum(np.ptp(given, axis=0), np.max(np.abs(rate), axis=0) * np.ptp(t))
-            for j, name in enumerate(_POSITION_NAMES):
+            for j, name in enumerate(names):
                 worst = int(np.argmax(deviation[:, j]))
                 by = float(deviation[worst, j])
                 if not (math.isfinite(by) and by <= MISMATCH_TOLERANCE * scale[j]):

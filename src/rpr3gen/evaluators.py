@@ -20,7 +20,7 @@ from typing import Protocol
 
 import numpy as np
 
-from rpr3gen import failures
+from rpr3gen import composed, failures
 from rpr3gen.buffers import OUTPUTS
 from rpr3gen.errors import InputError
 from rpr3gen.loader import numpy_module
@@ -149,6 +149,9 @@ class NumpyEvaluator:
         outputs: Sequence[np.ndarray],
         threads: int = 1,
     ) -> int | None:
+        if function.numpy_function is None and composed.composable(self.variant, function):
+            composed.run(self.variant, function, params, inputs, outputs, self._generated)
+            return None
         if function.numpy_function is None:
             raise InputError(
                 f"{function.name} has no NumPy version (its generated code is C only); "
@@ -167,6 +170,17 @@ class NumpyEvaluator:
         sums = self._sums(count)
         call(params, *inputs, *(o.T for o in outputs), work=work, sums=sums)
         return 0 if failures.none_failed(function, inputs, outputs, sums[:count]) else None
+
+    def _generated(
+        self, name: str, params: np.ndarray, inputs: Sequence[np.ndarray]
+    ) -> list[np.ndarray]:
+        """The generated NumPy function ``name`` on ``inputs``: its public outputs, (n, size)
+        each, failed samples NaN (for the compositions of :mod:`rpr3gen.composed`)."""
+        function = self.variant.function(name)
+        outputs = self.allocate(function, inputs[0].shape[0])
+        if self.run(function, params, inputs, outputs) != 0:
+            failures.apply(function, inputs, outputs)
+        return [o for o, info in zip(outputs, function.outputs, strict=True) if not info.hidden]
 
 
 class CEvaluator:

@@ -32,6 +32,7 @@ from rpr3gen.identification import friction_columns_of_rates
 from rpr3gen.model import LEGS, Model
 from rpr3gen.parameters import base_parameters, one_blas_thread, shared_matrix
 from rpr3gen.policy import joint_limits
+from rpr3gen.structure import planar_only
 from rpr3gen.trajectory import Trajectory
 from rpr3gen.validation import Integer, Number, Reading, checked
 
@@ -163,6 +164,7 @@ def excite(
         IdentificationError: no feasible starting motion (the central configuration itself
             violates the constraints).
     """
+    planar_only(model.structure, "excitation")
     if harmonics > (samples - 1) // 2:
         raise InputError(
             f"harmonics: {harmonics} harmonics need more than {2 * harmonics} samples per "

@@ -29,6 +29,7 @@ from rpr3gen.parameters import (
     regressor_and_codes,
     shared_matrix,
 )
+from rpr3gen.structure import planar_only
 from rpr3gen.validation import Number, Optional, Reading, Rows, Sample, checked
 
 MAX_WEIGHT_RATIO = 1e6
@@ -255,6 +256,7 @@ def identify(
             ``max_condition``): the fit is returned, and the warning names the estimates whose
             standard deviations the motion inflates most.
     """
+    planar_only(model.structure, "identification")
     q, qd, qdd, tau = (np.asarray(a) for a in (q, qd, qdd, tau))  # (n, 3) each: checked
     times = None if t is None else np.asarray(t)  # (n,), finite: checked
     n = q.shape[0]

@@ -84,6 +84,8 @@ class Variant:
     thresholds: dict[str, float]
     functions: dict[str, FunctionInfo]
     tables: dict[str, tuple[str, ...]] = field(default_factory=dict)  # extra name tables
+    #: The C header's extra macros by name, as C literals (``LEG``: ``"\"UPS\""``, ``DOF``).
+    defines: dict[str, str] = field(default_factory=dict)
 
     def function(self, name: str) -> FunctionInfo:
         """The function called ``name`` (without the prefix), or a clear error."""
@@ -214,6 +216,7 @@ def _variant(folder: Path, variant: str, data: dict) -> Variant:
         tables={
             name: tuple(c["name"] for c in comps) for name, comps in data.get("tables", {}).items()
         },
+        defines={str(k): str(v) for k, v in dict(data.get("defines", {})).items()},
     )
     missing = [role for role in ("numpy", "c_header", "c_source") if role not in found.files]
     if missing:

@@ -32,6 +32,7 @@ from rpr3gen.backends import evaluate
 from rpr3gen.control import platform_radius
 from rpr3gen.errors import IdentificationError, InputError, Rpr3genError
 from rpr3gen.model import LEGS, Model
+from rpr3gen.structure import planar_only
 from rpr3gen.validation import Rows, checked
 
 __all__ = [
@@ -121,7 +122,9 @@ def inertial_parameters(model: Model, identical_legs: bool = False) -> np.ndarra
 
     Raises:
         InputError: ``identical_legs`` with a general model whose legs' parameters differ.
+        ModelError: a spatial model (docs/spatial-robots.md: not yet).
     """
+    planar_only(model.structure, "inertial parameters")
     p = model.params
 
     def body(m: float, c: float, c_perp: float, j: float) -> list[float]:
@@ -193,6 +196,7 @@ def regressor_and_codes(
     model: Model, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, backend: str
 ) -> tuple[np.ndarray, np.ndarray]:
     """The per-leg regressor ``Y`` (n, 3, 28) and each sample's return code (0: evaluated)."""
+    planar_only(model.structure, "the regressor")
     _check_names(model)
     (Y,), codes = evaluate(model, "regressor", (q, qd, qdd), backend)
     return Y.reshape(-1, 3, len(INERTIAL_PARAMETER_NAMES)), codes
@@ -225,6 +229,7 @@ def regressor(
 def payload_efforts(model: Model, q: ArrayLike, backend: str = "numpy") -> np.ndarray:
     """``tau_payload`` (n, 3): the efforts holding the model's payload wrench at rest (generated,
     eqs. 12-17 with only the payload acting), which no inertial parameter scales."""
+    planar_only(model.structure, "payload_efforts")
     (tau,), _ = evaluate(model, "payload_efforts", (q,), backend)
     return tau
 
@@ -292,6 +297,7 @@ def _excitation_samples(model: Model, count: int) -> tuple[np.ndarray, ...]:
 @lru_cache(maxsize=32)
 @one_blas_thread
 def _base_parameters(model: Model, identical_legs: bool) -> BaseParameters:
+    planar_only(model.structure, "the base parameters")
     names = parameter_names(identical_legs)
     q, qd, qdd = _excitation_samples(model, 120)
     Y = regressor(model, q, qd, qdd, identical_legs)

@@ -49,6 +49,9 @@ LEG_STYLES: Mapping[str, Mapping[str, Any]] = MappingProxyType(
         "A": {"linestyle": "-", "linewidth": 3.0, "marker": "o", "markersize": 8},
         "B": {"linestyle": "--", "linewidth": 2.0, "marker": "s", "markersize": 6},
         "C": {"linestyle": ":", "linewidth": 1.5, "marker": "^", "markersize": 5},
+        "D": {"linestyle": "-.", "linewidth": 1.5, "marker": "v", "markersize": 5},
+        "E": {"linestyle": "-", "linewidth": 1.0, "marker": "D", "markersize": 4},
+        "F": {"linestyle": "--", "linewidth": 1.0, "marker": "x", "markersize": 4},
     }
 )
 """Line and marker of each leg: drawn in this order, wide to narrow, with hollow markers at
@@ -134,6 +137,26 @@ def _general_families(structure: Structure) -> tuple[FamilyPlot, ...]:
     return tuple(out)
 
 
+def _spatial_families(structure: Structure) -> tuple[FamilyPlot, ...]:
+    """A spatial robot's figures (docs/spatial-robots.md): every joint's force components, the
+    moments of the joints that transmit one (not the S joints), the efforts and the actuated
+    and prismatic joints' coordinates."""
+    delta = structure.leg.endswith("SS2")
+    out = []
+    for j in range(1, 6 if delta else 4):
+        for a in "xyz":
+            out.append(FamilyPlot(f"f{a}{j}", f"Joint {j} forces", rf"$f_{{{a}{j}}}$", "N"))
+        if j == 1 or (not delta and j == 2):
+            for a in "xyz":
+                out.append(FamilyPlot(f"m{a}{j}", f"Joint {j} moments", rf"$m_{{{a}{j}}}$", "N·m"))
+    unit = "N·m" if structure.actuated_kind == "R" else "N"
+    out.append(FamilyPlot("tau", "Actuator efforts", r"$\tau$", unit))
+    joint = structure.actuated
+    kind, unit = ("rotations", "rad") if structure.actuated_kind == "R" else ("displacements", "m")
+    out.append(FamilyPlot(f"q{joint}", f"Joint {joint} {kind}", rf"$q_{{{joint}}}$", unit))
+    return tuple(out)
+
+
 def plotted_families(actuation: str | Structure) -> tuple[FamilyPlot, ...]:
     """The families :func:`plot_families` draws for a robot, in order.
 
@@ -145,6 +168,8 @@ def plotted_families(actuation: str | Structure) -> tuple[FamilyPlot, ...]:
         InputError: If ``actuation`` is not one of these.
     """
     if isinstance(actuation, Structure):
+        if actuation.spatial:
+            return _spatial_families(actuation)
         if not actuation.paper:
             return _general_families(actuation)
         actuation = actuation.variant
@@ -189,9 +214,10 @@ def plot_families(
     if t.ndim != 1:
         raise InputError(f"t must have shape (n,), got {t.shape}")
     families = plotted_families(actuation)
+    legs = actuation.legs if isinstance(actuation, Structure) else LEGS
     curves: dict[str, np.ndarray] = {}
     for spec in families:
-        for leg in LEGS:
+        for leg in legs:
             key = f"{spec.family}_{leg}"
             if key not in outputs:
                 raise InputError(f"no output named {key!r} to plot")
@@ -205,7 +231,7 @@ def plot_families(
     written = []
     for spec in families:
         path = folder / f"{prefix}_{spec.family}.png"
-        fig = family_figure(t, [curves[f"{spec.family}_{leg}"] for leg in LEGS], spec, title)
+        fig = family_figure(t, [curves[f"{spec.family}_{leg}"] for leg in legs], spec, title)
         with atomic_write(path, "wb") as f:
             fig.savefig(f, format="png", dpi=DPI, metadata={"Software": None})
         written.append(path)
@@ -237,7 +263,7 @@ def coinciding_legs(curves: Sequence[np.ndarray]) -> tuple[tuple[str, ...], ...]
         ]
         placed.update(group)
         if len(group) > 1:
-            groups.append(tuple(LEGS[k] for k in group))
+            groups.append(tuple("ABCDEF"[k] for k in group))
     return tuple(groups)
 
 
@@ -263,12 +289,12 @@ def family_figure(
     FigureCanvasAgg(fig)
     ax = fig.add_subplot()
     step = max(1, len(t) // MARKERS_PER_CURVE)
-    for k, (leg, y) in enumerate(zip(LEGS, legs, strict=True)):
+    for k, (leg, y) in enumerate(zip("ABCDEF", legs, strict=False)):
         ax.plot(
             t,
             y,
             label=f"leg {leg}",
-            markevery=(k * step // len(LEGS), step),  # staggered: markers never overlap
+            markevery=(k * step // len(legs), step),  # staggered: markers never overlap
             markerfacecolor="none",
             **LEG_STYLES[leg],
         )

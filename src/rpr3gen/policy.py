@@ -89,13 +89,14 @@ def _singular_reason(
     else:
         (diagnostics,), _ = evaluate(model, "pose_diagnostics", (q,))
         *reaches, conditioning = diagnostics[0]
-        for leg, r in zip(LEGS, reaches, strict=True):
+        legs = model.structure.legs
+        for leg, r in zip(legs, reaches, strict=True):
             if not np.isfinite(r):
                 return f"leg {leg} cannot reach this pose in its working mode"
         k = int(np.argmin(reaches))
         if not reaches[k] >= thresholds["MIN_REACH"]:
             return (
-                f"leg {LEGS[k]} is at a serial singularity (reach {reaches[k]:.3g}: its joints' "
+                f"leg {legs[k]} is at a serial singularity (reach {reaches[k]:.3g}: its joints' "
                 "motions dependent)"
             )
     what = "a singular pose" if not conditioning >= floor else f"conditioning {conditioning:.3g}"

@@ -84,7 +84,9 @@ def simulate(
     invalid = screen(model, traj, out, min_conditioning, allow_invalid)
     if out_csv:
         Path(out_csv).parent.mkdir(parents=True, exist_ok=True)
-        write_results_csv(out_csv, traj.t, traj.q, out, output_names(model))
+        write_results_csv(
+            out_csv, traj.t, traj.q, out, output_names(model), pose=model.structure.pose
+        )
     if plots_dir:
         from rpr3gen.plots import plot_families
 

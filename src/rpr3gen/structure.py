@@ -21,6 +21,49 @@ LEGS: tuple[str, ...] = ("A", "B", "C")
 #: Every leg type, joint types from base to platform (PPP cannot turn the platform).
 LEG_TYPES: tuple[str, ...] = ("RRR", "RPR", "RRP", "PRR", "PPR", "PRP", "RPP")
 
+#: The spatial leg types (docs/spatial-robots.md): leg type -> (legs, actuated joint, the
+#: platform's degrees of freedom).
+SPATIAL_LEG_TYPES: dict[str, tuple[str, int, int]] = {
+    "UPS": ("ABCDEF", 2, 6),
+    "RUS": ("ABCDEF", 1, 6),
+    "PUS": ("ABCDEF", 1, 6),
+    "RSS2": ("ABC", 1, 3),
+    "PSS2": ("ABC", 1, 3),
+}
+
+#: The six entries of an inertia tensor, in the model file's order.
+INERTIA_ENTRIES: tuple[str, ...] = ("xx", "yy", "zz", "xy", "xz", "yz")
+
+#: The spatial platform's parameters, after the legs'.
+SPATIAL_PLATFORM_PARAMS: tuple[str, ...] = (
+    "m3", "c3x", "c3y", "c3z", *(f"I3{e}" for e in INERTIA_ENTRIES),
+    "gx", "gy", "gz", "fx", "fy", "fz", "mx", "my", "mz",
+)  # fmt: skip
+
+
+def spatial_leg_params(leg: str) -> tuple[str, ...]:
+    """One spatial leg's parameter names without the leg suffix, in order."""
+    names = ["bx", "by", "bz"]
+    if leg != "UPS":
+        names += ["ax", "ay", "az"]
+    if leg in ("UPS", "RUS", "PUS"):
+        names += ["u1x", "u1y", "u1z", "u2x", "u2y", "u2z"]
+    if leg != "UPS":
+        names += ["ex", "ey", "ez"]
+    names += ["px", "py", "pz"]
+    if leg == "PSS2":
+        names += ["barx", "bary", "barz"]
+    if leg != "UPS":
+        names.append("sigma")
+    bodies = 1 if leg.endswith("SS2") else 2
+    names += [f"m{k}" for k in range(1, bodies + 1)]
+    names += [f"c{k}{a}" for k in range(1, bodies + 1) for a in "xyz"]
+    names += [f"I{k}{e}" for k in range(1, bodies + 1) for e in INERTIA_ENTRIES]
+    if leg.endswith("SS2"):
+        names += ["w", "mr", "fr", "Ir"]
+    return tuple(names)
+
+
 #: The paper's variants: actuation scheme -> actuated joint of its RPR legs.
 PAPER_ACTUATIONS: dict[str, int] = {"revolute": 1, "prismatic": 2}
 
@@ -37,10 +80,42 @@ class Structure:
     paper: bool = False
 
     def __post_init__(self) -> None:
+        if self.leg in SPATIAL_LEG_TYPES:
+            joint = SPATIAL_LEG_TYPES[self.leg][1]
+            if self.actuated != joint:
+                raise ModelError(
+                    f"actuated: a {self.leg} leg carries its motor on joint {joint}, got "
+                    f"{self.actuated!r}"
+                )
+            return
         if self.leg not in LEG_TYPES:
-            raise ModelError(f"leg: must be one of {', '.join(LEG_TYPES)}, got {self.leg!r}")
+            every = (*LEG_TYPES, *SPATIAL_LEG_TYPES)
+            raise ModelError(f"leg: must be one of {', '.join(every)}, got {self.leg!r}")
         if self.actuated not in (1, 2, 3):
             raise ModelError(f"actuated: must be 1, 2 or 3, got {self.actuated!r}")
+
+    @property
+    def spatial(self) -> bool:
+        """A spatial robot (a hexapod or a Delta; docs/spatial-robots.md)."""
+        return self.leg in SPATIAL_LEG_TYPES
+
+    @property
+    def legs(self) -> tuple[str, ...]:
+        """The legs' letters: A, B, C (planar robots and Deltas) or A to F (hexapods)."""
+        return tuple(SPATIAL_LEG_TYPES[self.leg][0]) if self.spatial else LEGS
+
+    @property
+    def dof(self) -> int:
+        """The platform's degrees of freedom, the size of ``q``: 3 (planar robots and Deltas)
+        or 6 (hexapods)."""
+        return SPATIAL_LEG_TYPES[self.leg][2] if self.spatial else 3
+
+    @property
+    def pose(self) -> tuple[str, ...]:
+        """The pose coordinates' names: ``x, y, phi``; ``x, y, z, a, b, c``; or ``x, y, z``."""
+        if not self.spatial:
+            return ("x", "y", "phi")
+        return ("x", "y", "z", "a", "b", "c") if self.dof == 6 else ("x", "y", "z")
 
     @classmethod
     def of_variant(cls, variant: str) -> Structure:
@@ -62,7 +137,7 @@ class Structure:
     @property
     def actuated_kind(self) -> str:
         """``"R"`` or ``"P"``: the actuated joint's type."""
-        return self.leg[self.actuated - 1]
+        return "R" if self.leg[self.actuated - 1] == "R" else "P"
 
     @property
     def actuation(self) -> str:
@@ -71,13 +146,15 @@ class Structure:
 
     @property
     def title(self) -> str:
-        """E.g. ``3-RRR, motors on joint 1``."""
-        return f"3-{self.leg}, motors on joint {self.actuated}"
+        """E.g. ``3-RRR, motors on joint 1`` or ``6-UPS, motors on joint 2``."""
+        return f"{len(self.legs)}-{self.leg}, motors on joint {self.actuated}"
 
     @property
     def hold(self) -> str:
         """How a locked leg holds the platform: ``circle``, ``line``, ``platform_line`` or
         ``angle`` (architecturally singular)."""
+        if self.spatial:
+            return "spatial"
         return _HOLD["".join(self.leg[j - 1] for j in (1, 2, 3) if j != self.actuated)]
 
     @property
@@ -125,6 +202,10 @@ class Structure:
         """The parameter vector of the structure's variant, in order (docs/interfaces.md)."""
         if self.paper:
             return PAPER_PARAM_NAMES
+        if self.spatial:
+            per_leg = spatial_leg_params(self.leg)
+            legs = [f"{n}_{leg}" for leg in self.legs for n in per_leg]
+            return (*legs, *SPATIAL_PLATFORM_PARAMS)
         names: list[str] = []
         for leg in LEGS:
             names += [f"{a}{j}_{leg}" for j in (1, 2, 3) for a in "xy"]
@@ -148,3 +229,20 @@ PAPER_PARAM_NAMES: tuple[str, ...] = (
 
 #: Every structure of the general format (21), singular ones included.
 ALL: tuple[Structure, ...] = tuple(Structure(leg, a) for leg in LEG_TYPES for a in (1, 2, 3))
+
+
+def planar_only(structure: Structure, what: str) -> None:
+    """Refuse a spatial robot where ``what`` serves planar robots only so far.
+
+    Raises:
+        ModelError: naming ``what`` and the structure (a ``ValueError``).
+    """
+    if structure.spatial:
+        raise ModelError(
+            f"{what}: not available for spatial robots yet (the {structure.title}); "
+            "docs/spatial-robots.md lists what is"
+        )
+
+
+#: The spatial structures (5).
+SPATIAL: tuple[Structure, ...] = tuple(Structure(k, v[1]) for k, v in SPATIAL_LEG_TYPES.items())

@@ -35,14 +35,28 @@ __all__ = [
     "DEFAULT_SAMPLES",
     "DURATIONS",
     "PAPER_TRAJECTORIES",
+    "PLANAR_POSE",
     "POSITION_COLUMNS",
     "Trajectory",
+    "csv_columns",
     "paper_trajectory",
     "read_trajectory_csv",
     "write_trajectory_csv",
 ]
 
 CSV_COLUMNS: tuple[str, ...] = ("t", "x", "y", "phi", "dx", "dy", "dphi", "ddx", "ddy", "ddphi")
+
+PLANAR_POSE: tuple[str, ...] = ("x", "y", "phi")
+"""The pose of a planar robot; a spatial robot's is its structure's ``pose`` (``x, y, z, a, b,
+c`` for a hexapod, ``x, y, z`` for a Delta; docs/spatial-robots.md)."""
+
+
+def csv_columns(pose: Sequence[str] = PLANAR_POSE) -> tuple[str, ...]:
+    """The columns of a trajectory file of the pose ``pose``: ``t``, the pose, its ``d``- and
+    ``dd``-prefixed rates and accelerations."""
+    return ("t", *pose, *(f"d{n}" for n in pose), *(f"dd{n}" for n in pose))
+
+
 """Columns of a trajectory CSV file, in the order :func:`write_trajectory_csv` writes them."""
 
 POSITION_COLUMNS: tuple[str, ...] = CSV_COLUMNS[:4]
@@ -73,9 +87,11 @@ class Trajectory:
 
     Attributes:
         t: Sample times, s, shape ``(n,)``.
-        q: Pose ``(x, y, phi)`` per sample (m, m, rad), shape ``(n, 3)``.
-        qd: Velocity ``(dx, dy, dphi)`` (m/s, m/s, rad/s), shape ``(n, 3)``.
-        qdd: Acceleration ``(ddx, ddy, ddphi)`` (m/s², m/s², rad/s²), shape ``(n, 3)``.
+        q: Pose ``(x, y, phi)`` per sample (m, m, rad), shape ``(n, 3)``; a spatial robot's
+            pose (docs/spatial-robots.md): ``(n, 6)`` for a hexapod, ``(n, 3)`` for a Delta.
+        qd: Velocity ``(dx, dy, dphi)`` (m/s, m/s, rad/s), shape ``(n, 3)`` (or the pose's).
+        qdd: Acceleration ``(ddx, ddy, ddphi)`` (m/s², m/s², rad/s²), shape ``(n, 3)`` (or the
+            pose's).
     """
 
     t: np.ndarray
@@ -87,14 +103,19 @@ class Trajectory:
         t = np.array(numbers("t", self.t, TrajectoryError))  # InputTypeError: not numbers
         if t.ndim != 1 or t.size == 0:
             raise TrajectoryError(f"trajectory: t must have shape (n,) with n >= 1, got {t.shape}")
+        try:  # the pose's width (3, or a hexapod's 6); a malformed q is reported below
+            shape = np.shape(self.q)
+        except ValueError:
+            shape = ()
+        width = 6 if len(shape) == 2 and shape[1] == 6 else 3
         for name in ("t", "q", "qd", "qdd"):
             value = (
                 t if name == "t" else np.array(numbers(name, getattr(self, name), TrajectoryError))
             )
-            if name != "t" and value.shape != (t.size, 3):
+            if name != "t" and value.shape != (t.size, width):
                 raise TrajectoryError(
-                    f"trajectory: {name} must have shape ({t.size}, 3), a row per time of t, "
-                    f"got {value.shape}"
+                    f"trajectory: {name} must have shape ({t.size}, {width}), a row per time of "
+                    f"t, got {value.shape}"
                 )
             value.setflags(write=False)
             object.__setattr__(self, name, value)
@@ -113,7 +134,13 @@ class Trajectory:
 
     @classmethod
     def from_positions(
-        cls, t: np.ndarray, q: np.ndarray, smoothing: float = 0.0, *, source: str = "positions"
+        cls,
+        t: np.ndarray,
+        q: np.ndarray,
+        smoothing: float = 0.0,
+        *,
+        source: str = "positions",
+        pose: Sequence[str] = PLANAR_POSE,
     ) -> Trajectory:
         """The motion through the poses ``q``, with the derivatives of a quintic spline.
 
@@ -139,7 +166,9 @@ class Trajectory:
             raise TrajectoryError(f"{source}: t and q must be finite")
         if np.any(np.diff(given.t) <= 0):
             raise TrajectoryError(f"{source}: time must be strictly increasing")
-        q_fit, qd, qdd = differentiate(given.t, given.q, smoothing, source=source)
+        q_fit, qd, qdd = differentiate(
+            given.t, given.q, smoothing, source=source, names=tuple(pose)
+        )
         return cls(t=given.t, q=q_fit, qd=qd, qdd=qdd)
 
 
@@ -191,9 +220,16 @@ def paper_trajectory(
     return Trajectory(t=t, q=q, qd=qd, qdd=qdd)
 
 
-@checked(path=PathArg(), smoothing=Optional(Number(least=0.0, most=MAX_SMOOTHING)))
+@checked(
+    path=PathArg(),
+    smoothing=Optional(Number(least=0.0, most=MAX_SMOOTHING)),
+    pose=Instance(tuple, "the pose's column names, a tuple of str"),
+)
 def read_trajectory_csv(
-    path: str | os.PathLike[str], *, smoothing: float | None = None
+    path: str | os.PathLike[str],
+    *,
+    smoothing: float | None = None,
+    pose: Sequence[str] = PLANAR_POSE,
 ) -> Trajectory:
     """Read a trajectory CSV file (layout in the module docstring).
 
@@ -210,6 +246,8 @@ def read_trajectory_csv(
         smoothing: For a file of positions only: the RMS deviation allowed between the fitted
             spline and the positions (m for x and y, rad for phi); None or 0 passes through
             every sample. An error with a file that gives the derivatives.
+        pose: The pose's column names: ``("x", "y", "phi")`` (planar robots, the default), or a
+            spatial model's ``model.structure.pose`` (``x, y, z, a, b, c`` or ``x, y, z``).
 
     Raises:
         TrajectoryError: If the file cannot be read, a column is missing, a value is not a
@@ -222,12 +260,16 @@ def read_trajectory_csv(
         TrajectoryWarning: If the file's velocities or accelerations disagree with its
             positions (a ``UserWarning``; the command prints it as one line).
     """
-    traj, _ = read_trajectory_columns(path, (), smoothing=smoothing)
+    traj, _ = read_trajectory_columns(path, (), smoothing=smoothing, pose=tuple(pose))
     return traj
 
 
 def read_trajectory_columns(
-    path: str | os.PathLike[str], extra: Sequence[str], *, smoothing: float | None = None
+    path: str | os.PathLike[str],
+    extra: Sequence[str],
+    *,
+    smoothing: float | None = None,
+    pose: Sequence[str] = PLANAR_POSE,
 ) -> tuple[Trajectory, np.ndarray]:
     """:func:`read_trajectory_csv` of a file that also has the columns ``extra`` (required,
     checked as the trajectory's are): the trajectory and those columns, (n, len(extra)).
@@ -239,7 +281,7 @@ def read_trajectory_columns(
         smoothing = check_smoothing(smoothing)
     try:
         with open(source, encoding="utf-8-sig", newline="") as f:
-            table = _parse(f, source, tuple(extra))
+            table = _parse(f, source, tuple(extra), tuple(pose))
     except FileNotFoundError:
         raise TrajectoryError(f"{source}: trajectory file not found") from None
     except IsADirectoryError:
@@ -252,24 +294,30 @@ def read_trajectory_columns(
     except OSError as exc:
         raise TrajectoryError(f"{source}: cannot read: {exc.strerror or exc}") from None
     data, columns = table[:, : table.shape[1] - len(extra)], table[:, table.shape[1] - len(extra) :]
-    t, q = data[:, 0], data[:, 1:4]
-    if data.shape[1] == len(POSITION_COLUMNS):
-        return Trajectory.from_positions(t, q, smoothing or 0.0, source=source), columns
+    k = len(pose)
+    t, q = data[:, 0], data[:, 1 : 1 + k]
+    if data.shape[1] == 1 + k:
+        return Trajectory.from_positions(t, q, smoothing or 0.0, source=source, pose=pose), columns
     if smoothing is not None:
         raise TrajectoryError(
-            f"{source}: smoothing is for a file of positions only (t,x,y,phi); this one gives "
+            f"{source}: smoothing is for a file of positions only (t,{','.join(pose)}); this one "
+            "gives "
             "the velocities and accelerations"
         )
-    traj = Trajectory(t=t, q=q, qd=data[:, 4:7], qdd=data[:, 7:10])
-    problem = mismatch(traj.t, traj.q, traj.qd, traj.qdd)
+    traj = Trajectory(t=t, q=q, qd=data[:, 1 + k : 1 + 2 * k], qdd=data[:, 1 + 2 * k : 1 + 3 * k])
+    problem = mismatch(traj.t, traj.q, traj.qd, traj.qdd, tuple(pose))
     if problem:
         warnings.warn(f"{source}: {problem}", TrajectoryWarning, stacklevel=3)
     return traj, columns
 
 
-def _parse(f: TextIO, source: str, extra: tuple[str, ...] = ()) -> np.ndarray:
+def _parse(
+    f: TextIO, source: str, extra: tuple[str, ...] = (), pose: tuple[str, ...] = PLANAR_POSE
+) -> np.ndarray:
     """The table of a trajectory file: columns :data:`CSV_COLUMNS` or :data:`POSITION_COLUMNS`,
     then the required columns ``extra``."""
+    every = csv_columns(pose)
+    positions = every[: 1 + len(pose)]
     reader = csv.reader(f)
     header: list[str] | None = None
     for row in reader:
@@ -277,19 +325,19 @@ def _parse(f: TextIO, source: str, extra: tuple[str, ...] = ()) -> np.ndarray:
             header = [cell.strip() for cell in row]
             break
     if header is None:
-        raise TrajectoryError(f"{source}: empty file (expected a header {','.join(CSV_COLUMNS)})")
+        raise TrajectoryError(f"{source}: empty file (expected a header {','.join(every)})")
     header_line = reader.line_num
 
     index: dict[str, int] = {}
     for i, name in enumerate(header):
-        if (name in CSV_COLUMNS or name in extra) and name in index:
+        if (name in every or name in extra) and name in index:
             raise TrajectoryError(
                 f"{source}: line {header_line} (header): column {name!r} appears twice"
             )
         index.setdefault(name, i)
     # Positions alone, or everything: a file with some of the derivatives lacks the others.
-    given = any(name in index for name in CSV_COLUMNS[len(POSITION_COLUMNS) :])
-    columns = (*(CSV_COLUMNS if given else POSITION_COLUMNS), *extra)
+    given = any(name in index for name in every[len(positions) :])
+    columns = (*(every if given else positions), *extra)
     for name in columns:
         if name not in index:
             others = [h for h in header if h not in columns]
@@ -329,7 +377,9 @@ def _parse(f: TextIO, source: str, extra: tuple[str, ...] = ()) -> np.ndarray:
     return np.array(values, dtype=np.float64)
 
 
-def write_trajectory_csv(path: str | os.PathLike[str], traj: Trajectory) -> None:
+def write_trajectory_csv(
+    path: str | os.PathLike[str], traj: Trajectory, pose: Sequence[str] = PLANAR_POSE
+) -> None:
     """Write ``traj`` as a trajectory CSV file that :func:`read_trajectory_csv` reads back exactly.
 
     Columns are :data:`CSV_COLUMNS`; values are written with ``%.17g`` so they round-trip
@@ -338,4 +388,5 @@ def write_trajectory_csv(path: str | os.PathLike[str], traj: Trajectory) -> None
     Raises:
         OSError: If the file cannot be written.
     """
-    write_csv_table(path, CSV_COLUMNS, np.column_stack([traj.t, traj.q, traj.qd, traj.qdd]))
+    columns = csv_columns(pose)
+    write_csv_table(path, columns, np.column_stack([traj.t, traj.q, traj.qd, traj.qdd]))

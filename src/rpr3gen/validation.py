@@ -49,12 +49,14 @@ __all__ = [
     "Number",
     "Optional",
     "PathArg",
+    "PoseRows",
     "Reading",
     "Rows",
     "Sample",
     "check_same_length",
     "checked",
     "describe",
+    "match_width",
     "numbers",
 ]
 
@@ -307,6 +309,38 @@ class Rows(Check):
             row = int(np.flatnonzero(~np.isfinite(array).all(axis=1))[0])
             raise _value_error(name, f"row {row + 1}: a value is not finite")
         return np.ascontiguousarray(array)
+
+
+class PoseRows(Check):
+    """Rows of a platform quantity whose width is the model's (3: planar robots and Deltas;
+    6: hexapods): ``(n, 3)`` or ``(n, 6)`` here, matched to the model by :func:`match_width`."""
+
+    WIDTHS = (3, 6)
+
+    def __init__(self, *, finite: bool = False) -> None:
+        self.finite = finite
+
+    def __call__(self, name: str, value: Any) -> np.ndarray:
+        array = numbers(name, value)
+        width = array.shape[-1] if array.ndim in (1, 2) else None
+        if width not in self.WIDTHS:
+            raise _value_error(
+                name,
+                "must have shape (n, 3) or (n, 6) (or (3,) or (6,) for one sample), got "
+                f"{array.shape}",
+            )
+        return Rows(int(width), finite=self.finite)(name, array)
+
+
+def match_width(width: int, title: str, **arrays: np.ndarray) -> None:
+    """Refuse arrays of :class:`PoseRows` whose width is not the model's ``width``."""
+    for name, array in arrays.items():
+        if array.shape[1] != width:
+            raise _value_error(
+                name,
+                f"must have shape (n, {width}) (or ({width},) for one sample) for the {title}, "
+                f"got (n, {array.shape[1]})",
+            )
 
 
 class Reading(Check):

@@ -77,7 +77,7 @@ def _derive(structure: Structure, root: Path) -> None:
     """Derive and write the variant's files into ``root/<variant>`` (atomically)."""
     try:
         from rpr3gen_derive.codegen.files import write_files
-        from rpr3gen_derive.planar import generate, structures
+        from rpr3gen_derive.planar import generate
     except ImportError as exc:
         raise Rpr3genError(
             f"the {structure.title} is not generated yet and deriving it needs sympy and "
@@ -89,7 +89,7 @@ def _derive(structure: Structure, root: Path) -> None:
         file=sys.stderr,
         flush=True,
     )
-    target = structures.Structure(structure.leg, structure.actuated, structure.paper)
+    target = generate.structure_of(structure.leg, structure.actuated, structure.paper)
     files = generate.render((target,), package=(target,))
     root.mkdir(parents=True, exist_ok=True)
     staging = Path(tempfile.mkdtemp(prefix=".staging-", dir=root))

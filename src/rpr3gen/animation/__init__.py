@@ -47,6 +47,7 @@ from rpr3gen.animation.writers import writer
 from rpr3gen.atomic import atomic_path
 from rpr3gen.model import Model
 from rpr3gen.policy import DEFAULT_MIN_CONDITIONING
+from rpr3gen.structure import planar_only
 from rpr3gen.trajectory import Trajectory
 
 __all__ = [
@@ -107,6 +108,7 @@ def write_animation(
         Rpr3genError: For a trajectory through an invalid pose.
         OSError: If the file cannot be written.
     """
+    planar_only(model.structure, "animate")
     the_plan = plan(traj.t, out, fps=fps, speed=speed, size=size)
     scn = scene(
         model, traj, title=title, loads=loads, backend=backend, min_conditioning=min_conditioning

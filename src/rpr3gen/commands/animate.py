@@ -10,6 +10,7 @@ from rpr3gen.commands import options
 from rpr3gen.commands.args import integer, number
 from rpr3gen.model import load_model
 from rpr3gen.paths import check_output
+from rpr3gen.structure import planar_only
 
 NAME = "animate"
 
@@ -57,9 +58,10 @@ def run(args: argparse.Namespace) -> int:
     """Check the movie's plan before any work, then draw and write it."""
     check_output(args.out, "the movie", argument="out")
     size = animation.parse_size(args.size)
+    model = load_model(args.model)
+    planar_only(model.structure, "rpr3gen animate")
     name, traj = options.trajectory(args)
     animation.plan(traj.t, args.out, fps=args.fps, speed=args.speed, size=size)  # before work
-    model = load_model(args.model)
     done = animation.write_animation(
         model, traj, args.out, fps=args.fps, speed=args.speed, size=size, loads=args.loads,
         title=f"{model.name}: {model.structure.title}, {name}", backend=args.backend,

@@ -9,6 +9,7 @@ from rpr3gen.commands import options
 from rpr3gen.commands.args import integer, number
 from rpr3gen.model import load_model
 from rpr3gen.paths import check_output
+from rpr3gen.structure import planar_only
 
 NAME = "excite"
 
@@ -50,6 +51,8 @@ def run(args: argparse.Namespace) -> int:
     from rpr3gen.trajectory import write_trajectory_csv
 
     model = load_model(args.model)
+
+    planar_only(model.structure, "rpr3gen excite")
     out = check_output(args.out, "the trajectory", argument="out")
     found = excite(
         model,

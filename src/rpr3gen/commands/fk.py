@@ -10,6 +10,7 @@ import numpy as np
 from rpr3gen.backends import inverse_dynamics
 from rpr3gen.commands import options
 from rpr3gen.commands.args import number
+from rpr3gen.errors import InputError
 from rpr3gen.model import load_model
 
 NAME = "fk"
@@ -19,15 +20,19 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     """The ``fk`` subcommand's parser."""
     parser = sub.add_parser(
         NAME,
-        help="forward kinematics: every assembly mode of three actuator readings",
+        help="forward kinematics: every assembly mode of the actuator readings",
         description="Print every assembly mode of the actuator coordinates QA1 QA2 QA3 (legs A, "
         "B, C: phi10 in rad with revolute actuation, lambda21 in m with prismatic), one per "
         "line: x y (m) phi (rad, in (-pi, pi]) and the pose's conditioning (0 = singular, 1 = "
-        "best).",
+        "best). A spatial robot takes one reading per leg (a hexapod six, a Delta three) and "
+        "prints x y z (m) and, for a hexapod, a b c (rad); a Delta's modes in closed form, a "
+        "hexapod's those its documented search finds (docs/spatial-robots.md).",
     )
     options.add_model(parser)
     options.add_generated(parser)
-    parser.add_argument("qa", nargs=3, type=number(), metavar="QA", help="actuator coordinate")
+    parser.add_argument(
+        "qa", nargs="+", type=number(), metavar="QA", help="actuator coordinate, one per leg"
+    )
 
 
 def run(args: argparse.Namespace) -> int:
@@ -35,7 +40,13 @@ def run(args: argparse.Namespace) -> int:
     from rpr3gen.control import assembly_modes
 
     model = load_model(args.model, generated=args.generated)
-    qa = np.array(args.qa)  # three finite numbers (args.number)
+    legs = model.structure.legs
+    if len(args.qa) != len(legs):
+        raise InputError(
+            f"QA: the {model.structure.title} takes {len(legs)} actuator coordinates (legs "
+            f"{', '.join(legs)}), got {len(args.qa)}"
+        )
+    qa = np.array(args.qa)  # finite numbers (args.number)
     modes = assembly_modes(model, qa)
     zero = np.zeros_like(modes)
     conditioning = (
@@ -43,10 +54,11 @@ def run(args: argparse.Namespace) -> int:
     )
     family = model.structure.actuator
     what = f"{model.actuation} actuation" if model.structure.paper else model.structure.title
+    pose = " ".join(model.structure.pose)
     print(
         f"# {len(modes)} assembly mode(s) of {family} = {' '.join(f'{v:g}' for v in qa)} "
-        f"({model.name}, {what}): x y phi conditioning"
+        f"({model.name}, {what}): {pose} conditioning"
     )
     for mode, c in zip(modes, conditioning, strict=True):
-        print(f"{mode[0]:.12g} {mode[1]:.12g} {mode[2]:.12g} {c:.6g}")
+        print(" ".join(f"{v:.12g}" for v in mode) + f" {c:.6g}")
     return 0

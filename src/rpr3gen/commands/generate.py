@@ -10,7 +10,7 @@ from rpr3gen import variants
 from rpr3gen.errors import InputError, Rpr3genError, did_you_mean
 from rpr3gen.model import load_model
 from rpr3gen.paths import check_output
-from rpr3gen.structure import LEG_TYPES, Structure
+from rpr3gen.structure import LEG_TYPES, SPATIAL_LEG_TYPES, Structure
 
 NAME = "generate"
 
@@ -21,7 +21,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         NAME,
         help="derive and write the generated sources",
         description="Derive and write generated code. Without --leg or --model: the committed "
-        "variants (the paper's revolute and prismatic, and rrr_1) into the source tree's "
+        "variants (the paper's revolute and prismatic, rrr_1, ups_2 and rss2_1) into the source "
+        "tree's "
         "generated/. With --leg and --actuated (or --model): that one structure's variant, into "
         "--out DIR, or by default into the cache where the runtime finds it (see "
         "RPR3GEN_CACHE_DIR).",
@@ -34,14 +35,16 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     parser.add_argument(
         "--leg",
         metavar="TYPE",
-        help="generate the variant of this leg type (RRR RPR RRP PRR PPR PRP RPP); needs the "
-        "actuated joint too (default: the committed variants)",
+        help="generate the variant of this leg type (planar: RRR RPR RRP PRR PPR PRP RPP; "
+        "spatial: UPS RUS PUS RSS2 PSS2); needs the actuated joint too (default: the committed "
+        "variants)",
     )
     parser.add_argument(
         "--actuated",
         type=int,
         metavar="J",
-        help="the joint (1, 2 or 3) of every leg that carries its motor; needs the leg type "
+        help="the joint (1, 2 or 3) of every leg that carries its motor (UPS: 2; the other "
+        "spatial types: 1); needs the leg type "
         "too (default: none)",
     )
     parser.add_argument(
@@ -63,7 +66,7 @@ def run(args: argparse.Namespace) -> int:
         check_output(args.out, "the generated sources", folder=True, argument="out")
     try:
         from rpr3gen_derive.codegen import files as codegen_files
-        from rpr3gen_derive.planar import generate, structures
+        from rpr3gen_derive.planar import generate
     except ImportError as exc:
         raise Rpr3genError(
             f"regeneration needs sympy and jinja2 ({exc.name} is missing): "
@@ -76,7 +79,7 @@ def run(args: argparse.Namespace) -> int:
                 f"--actuated: a {one.title} cannot move: both its passive joints are prismatic "
                 "(architecturally singular); nothing to generate"
             )
-        target = structures.Structure(one.leg, one.actuated, one.paper)
+        target = generate.structure_of(one.leg, one.actuated, one.paper)
         committed = target in generate.COMMITTED
         if args.out:
             out_dir = Path(args.out)
@@ -115,11 +118,18 @@ def _structure(args: argparse.Namespace) -> Structure | None:
         if args.leg is None or args.actuated is None:
             raise InputError("--leg and --actuated go together")
         leg = str(args.leg).upper()
-        if leg not in LEG_TYPES:
-            hint = did_you_mean(leg, LEG_TYPES)
-            raise InputError(
-                f"--leg: must be one of {', '.join(LEG_TYPES)}, got {args.leg!r}{hint}"
-            )
+        every = (*LEG_TYPES, *SPATIAL_LEG_TYPES)
+        if leg not in every:
+            hint = did_you_mean(leg, every)
+            raise InputError(f"--leg: must be one of {', '.join(every)}, got {args.leg!r}{hint}")
+        if leg in SPATIAL_LEG_TYPES:
+            joint = SPATIAL_LEG_TYPES[leg][1]
+            if args.actuated != joint:
+                raise InputError(
+                    f"--actuated: a {leg} leg carries its motor on joint {joint}, got "
+                    f"{args.actuated}"
+                )
+            return Structure(leg, args.actuated)
         if args.actuated not in (1, 2, 3):
             raise InputError(f"--actuated: must be 1, 2 or 3, got {args.actuated}")
         return Structure(leg, args.actuated)

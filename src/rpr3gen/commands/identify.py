@@ -20,6 +20,7 @@ from rpr3gen.commands import options
 from rpr3gen.commands.args import number
 from rpr3gen.model import LEGS, Model, load_model
 from rpr3gen.paths import check_output
+from rpr3gen.structure import planar_only
 
 if TYPE_CHECKING:  # imported when needed, as below: `import rpr3gen.cli` stays light
     from rpr3gen.identification import Fit
@@ -130,6 +131,8 @@ def run(args: argparse.Namespace) -> int:
     from rpr3gen.trajectory import read_trajectory_columns
 
     model = load_model(args.model)
+
+    planar_only(model.structure, "rpr3gen identify")
     if args.out:
         check_output(args.out, "the estimates", argument="out")
     family = model.structure.effort

@@ -19,6 +19,7 @@ from rpr3gen.trajectory import (
     DEFAULT_SAMPLES,
     DURATIONS,
     PAPER_TRAJECTORIES,
+    PLANAR_POSE,
     Trajectory,
     paper_trajectory,
     read_trajectory_csv,
@@ -156,11 +157,19 @@ def add_min_conditioning(
     )
 
 
-def trajectory(args: argparse.Namespace) -> tuple[str, Trajectory]:
+def trajectory(
+    args: argparse.Namespace, pose: tuple[str, ...] = PLANAR_POSE
+) -> tuple[str, Trajectory]:
     """The trajectory that ``--trajectory``, ``--samples``, ``--duration`` and ``--smoothing``
-    name, and its name (a paper trajectory's, or the CSV file's stem)."""
+    name, and its name (a paper trajectory's, or the CSV file's stem); ``pose``: the model's
+    pose coordinates (a spatial robot's take no paper trajectory)."""
     given = {"samples": args.samples, "duration": args.duration}
     timing = {key: value for key, value in given.items() if value is not None}
+    if args.trajectory in PAPER_TRAJECTORIES and pose != PLANAR_POSE:
+        raise TrajectoryError(
+            f"--trajectory: the paper's {args.trajectory!r} motion is planar; a spatial robot "
+            f"(pose {', '.join(pose)}) needs a trajectory CSV file: --trajectory FILE.csv"
+        )
     if args.trajectory in PAPER_TRAJECTORIES:
         if args.smoothing is not None:
             raise TrajectoryError(
@@ -181,4 +190,4 @@ def trajectory(args: argparse.Namespace) -> tuple[str, Trajectory]:
     if timing:
         options = " and ".join(f"--{key}" for key in timing)
         raise TrajectoryError(f"{options}: only for a paper trajectory; {path} has its own times")
-    return path.stem, read_trajectory_csv(path, smoothing=args.smoothing)
+    return path.stem, read_trajectory_csv(path, smoothing=args.smoothing, pose=pose)

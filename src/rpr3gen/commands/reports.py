@@ -79,13 +79,17 @@ def summary(
     if invalid is not None:
         valid = n - int(np.count_nonzero(invalid.mask))
         lines.append(f"  {refused(traj, invalid)}; the peaks are of the {valid} others")
-    lines.append(f"  {'peak |value|':<12} {'leg A':>12} {'leg B':>12} {'leg C':>12}")
-    families = (
-        ("m10", "f21z", "f10x", "f10y", "f21y", "m21", "f32y", "f32z")
-        if model.structure.paper
-        else ("tau", *(f"{f}{j}" for j in (1, 2, 3) for f in ("fx", "fy", "m")))
-    )
+    legs = model.structure.legs
+    lines.append(f"  {'peak |value|':<12} " + " ".join(f"{'leg ' + leg:>12}" for leg in legs))
+    if model.structure.paper:
+        families: tuple[str, ...] = ("m10", "f21z", "f10x", "f10y", "f21y", "m21", "f32y", "f32z")
+    elif model.structure.spatial:
+        joints = range(1, 6 if model.structure.leg.endswith("SS2") else 4)
+        families = ("tau", *(f"{f}{j}" for j in joints for f in ("fx", "fy", "fz", "mx", "my",
+                                                                  "mz")))  # fmt: skip
+    else:
+        families = ("tau", *(f"{f}{j}" for j in (1, 2, 3) for f in ("fx", "fy", "m")))
     for family in families:
-        peaks = [float(np.nanmax(np.abs(out[f"{family}_{leg}"]), initial=0.0)) for leg in "ABC"]
+        peaks = [float(np.nanmax(np.abs(out[f"{family}_{leg}"]), initial=0.0)) for leg in legs]
         lines.append(f"  {family:<12} " + " ".join(f"{p:12.5g}" for p in peaks))
     return "\n".join(lines)

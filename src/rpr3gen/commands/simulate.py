@@ -23,7 +23,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     parser.add_argument(
         "--out",
         metavar="FILE.csv",
-        help="write t,x,y,phi and every output as CSV, SI units (default: no file)",
+        help="write t, the pose (x,y,phi; spatial robots: x,y,z[,a,b,c]) and every output as "
+        "CSV, SI units (default: no file)",
     )
     parser.add_argument(
         "--plots",
@@ -47,7 +48,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     """Simulate the trajectory, warn of the samples refused, print the summary."""
     model = load_model(args.model, generated=args.generated)
-    name, traj = options.trajectory(args)
+    name, traj = options.trajectory(args, model.structure.pose)
     out, invalid = simulate(
         model,
         name,

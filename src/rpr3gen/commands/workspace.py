@@ -12,6 +12,7 @@ from rpr3gen.commands.args import integer, number
 from rpr3gen.design.maps import DEFAULT_RESOLUTION, WorkspaceMap
 from rpr3gen.model import load_model
 from rpr3gen.paths import check_output
+from rpr3gen.structure import planar_only
 
 NAME = "workspace"
 
@@ -50,6 +51,8 @@ def run(args: argparse.Namespace) -> int:
     from rpr3gen.design import workspace, write_workspace
 
     model = load_model(args.model)
+
+    planar_only(model.structure, "rpr3gen workspace")
     out = check_output(args.out, "the workspace maps", folder=True, argument="out")
     wmap = workspace(model, np.radians(args.phi), args.resolution,
                      min_conditioning=args.min_conditioning)  # fmt: skip

@@ -32,6 +32,7 @@ from rpr3gen.design.reach import (
 from rpr3gen.design.stacked import evaluate_stacked, leg_lengths, piston_displacements
 from rpr3gen.model import LEGS, Model
 from rpr3gen.policy import DEFAULT_MIN_CONDITIONING
+from rpr3gen.structure import planar_only
 from rpr3gen.validation import Integer, Number, checked
 
 __all__ = [
@@ -228,6 +229,7 @@ def workspace(
     Raises:
         InputError, InputTypeError: for a bad argument (:mod:`rpr3gen.validation`).
     """
+    planar_only(model.structure, "workspace")
     params = model.vector()
     limits = design_limits(model)
     bound = bounds(limits)

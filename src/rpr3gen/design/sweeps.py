@@ -42,7 +42,7 @@ from rpr3gen.evaluators import all_cores
 from rpr3gen.model import ACTUATIONS, model_from_dict, read_model_data
 from rpr3gen.paths import check_output
 from rpr3gen.policy import DEFAULT_MIN_CONDITIONING
-from rpr3gen.structure import Structure
+from rpr3gen.structure import Structure, planar_only
 from rpr3gen.trajectory import (
     DEFAULT_DURATION,
     DEFAULT_SAMPLES,
@@ -213,7 +213,7 @@ def make_plan(
         source, base = "<model>", dict(model)
     else:
         source, base = read_model_data(model)
-    model_from_dict(base, source=source)  # the base itself must be valid
+    planar_only(model_from_dict(base, source=source).structure, "sweep")  # valid, planar
     checked = read_grid(grid, base)
     papers = sum(isinstance(t, str) and t in PAPER_TRAJECTORIES for t in trajectories)
     check_paper_samples(samples, papers)

@@ -59,6 +59,8 @@ def check_fields(model: Any, actuations: Sequence[str]) -> dict:
     hint = "; structure=None means the paper's format" if model.structure is None else ""
     params = _params(model.params, source, param_names, hint)
     stroke = None if model.stroke is None else _stroke(model.stroke, source)
+    if model.limits is not None and structure.spatial:
+        raise ModelError(f"{source}: limits: joint limits are not supported for spatial models yet")
     limits = None if model.limits is None else _limits(model.limits, source, structure)
     generated = None
     if model.generated is not None:

@@ -1,9 +1,11 @@
 """Reading a model file or mapping: the format's reader picked by its keys.
 
 :func:`load_model` reads a TOML file, checks every key and value, applies the defaults of
-``docs/conventions.md`` and returns a :class:`~rpr3gen.model.Model`; a file with a top-level
-``leg`` key is of the general format (:mod:`rpr3gen.model.general`), one without it the
-paper's (:mod:`rpr3gen.model.paper`).
+``docs/conventions.md`` and returns a :class:`~rpr3gen.model.Model`; a file whose top-level
+``leg`` is a spatial leg type (UPS, RUS, PUS, RSS2, PSS2) describes a hexapod or a Delta
+(:mod:`rpr3gen.model.spatial`, docs/spatial-robots.md), one with another ``leg`` is of the
+general planar format (:mod:`rpr3gen.model.general`), one without it the paper's
+(:mod:`rpr3gen.model.paper`).
 """
 
 from __future__ import annotations
@@ -20,6 +22,7 @@ from rpr3gen.errors import ModelError
 from rpr3gen.model.general import is_general, read_general
 from rpr3gen.model.paper import read_paper
 from rpr3gen.model.reading import one_line
+from rpr3gen.model.spatial import is_spatial, read_spatial
 from rpr3gen.model.types import Model
 from rpr3gen.validation import Instance, Optional, PathArg, checked
 
@@ -96,13 +99,16 @@ def model_from_dict(data: Mapping[str, Any], source: str = "<dict>") -> Model:
     Args:
         data: Same structure as a model file: ``name``, ``actuation`` and the tables
             ``geometry``, ``mass``, optional ``environment`` and ``payload`` (the paper's
-            format), or ``leg``, ``actuated``, ``legs``, ``platform``... (the general format).
-            Lists may be lists, tuples or numpy arrays.
+            format), or ``leg``, ``actuated``, ``legs``, ``platform``... (the general planar
+            format, or a spatial robot's when ``leg`` is UPS, RUS, PUS, RSS2 or PSS2:
+            docs/spatial-robots.md). Lists may be lists, tuples or numpy arrays.
         source: Name used in error messages.
 
     Raises:
         ModelError: On the first problem found, naming ``source`` and the dotted key.
     """
+    if isinstance(data, Mapping) and is_spatial(data):
+        return read_spatial(data, source)
     if isinstance(data, Mapping) and is_general(data):
         return read_general(data, source)
     return read_paper(data, source)

@@ -1,4 +1,5 @@
-"""The :class:`Model` dataclass: a validated robot, of the paper's format or the general one.
+"""The :class:`Model` dataclass: a validated robot, of the paper's format, the general planar one
+or a spatial robot's (a hexapod or a Delta, docs/spatial-robots.md).
 
 A model read from a file (:mod:`rpr3gen.model.load`) is checked key by key first; one built in
 code (``Model(name, actuation, params, ...)`` or ``dataclasses.replace``) is checked field by
@@ -70,7 +71,7 @@ class _ReadOnlyParams(_ReadOnly[float]):
 
 @dataclass(frozen=True)
 class Model:
-    """A validated robot, of the paper's format or the general one.
+    """A validated robot, of the paper's format, the general planar one or a spatial one.
 
     Attributes:
         name: The model's name (``name`` in the file).
@@ -82,6 +83,10 @@ class Model:
             (m, platform frame), ``alpha_A..alpha_C`` (rad), lengths (m), masses (kg),
             inertias (kg m², about the COM, axis z), gravity ``gx, gy`` (m/s²) and the payload
             wrench at G ``fx, fy`` (N), ``mz`` (N m). The general format: docs/interfaces.md.
+            A spatial robot (a hexapod or a Delta): per leg ``L`` its points, unit axes, the
+            working mode ``sigma_L``, masses, centres of mass and inertia tensors (world frame,
+            z up, at home), then the platform's, gravity ``gx, gy, gz`` and the payload
+            ``fx, fy, fz, mx, my, mz``: docs/spatial-robots.md.
         source: Where the model came from (a file path or ``"<dict>"``), for messages.
         stroke: The paper's format: optional piston displacement bounds ``((lo, hi), ...)``
             for legs A, B, C (m, bounds on lambda21), from ``[limits] stroke``; else None.
@@ -91,7 +96,8 @@ class Model:
         structure: The leg type and actuated joint (and the format); None (only when built by
             hand) means the paper's of ``actuation``.
         limits: The general format: joint coordinate bounds ``{"A.q2": (lo, hi), ...}`` (m or
-            rad) from ``[limits]``; None when the file sets none.
+            rad) from ``[limits]``; None when the file sets none (always for spatial models,
+            whose files take no ``[limits]`` yet).
     """
 
     name: str

@@ -1,0 +1,495 @@
+"""The registry of a spatial variant's generated functions: one spec builder per function.
+
+Each entry of :data:`FUNCTIONS` turns a :class:`~.structures.SpatialStructure` into a
+:class:`~rpr3gen_derive.codegen.spec.FunctionSpec`; :func:`module` gathers them with the
+parameter vector, the return codes and the thresholds into the variant's
+:class:`~rpr3gen_derive.codegen.spec.ModuleSpec`. The return codes, thresholds and C ABI are the
+planar variants' (docs/interfaces.md), with ``q`` of 6 or 3 components.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from functools import cache
+
+import sympy as sp
+from rpr3gen_derive.codegen.program import Program
+from rpr3gen_derive.codegen.spec import (
+    Argument,
+    Check,
+    Component,
+    FunctionSpec,
+    ModuleSpec,
+    Output,
+    ReturnCode,
+    Threshold,
+)
+from rpr3gen_derive.spatial import virtual_work
+from rpr3gen_derive.spatial.platform import param, pose_symbols
+from rpr3gen_derive.spatial.structures import SpatialStructure, param_doc, param_names
+
+PREFIX = "rpr3"
+
+RETURN_CODES: tuple[ReturnCode, ...] = (
+    ReturnCode("OK", 0, "success"),
+    ReturnCode("NOT_FINITE", 1, "an input is NaN or infinite"),
+    ReturnCode(
+        "SINGULAR",
+        2,
+        "singular or degenerate pose: a leg at or near a serial singularity or out of reach "
+        "(reach below MIN_REACH), conditioning below MIN_CONDITIONING, or a result that would "
+        "not be finite",
+    ),
+    ReturnCode("NO_MODE", 3, "no assembly mode for these actuator coordinates"),
+)
+
+THRESHOLDS: tuple[Threshold, ...] = (
+    Threshold(
+        "MIN_REACH",
+        "1e-9",
+        "min over legs of the reach (UPS: the leg's length over its home length; the others: "
+        "D / D(home), D = (S - E) . dE/dq1 the leg's serial determinant; 1 at home) under "
+        "which a pose is refused: a leg at or near a serial singularity.",
+    ),
+    Threshold(
+        "MIN_CONDITIONING",
+        "1e-9",
+        'Output "conditioning" (0 at a parallel singularity, 1 at best) under which a pose '
+        "counts as singular.",
+    ),
+)
+
+_UNITS = {"x": "m", "y": "m", "z": "m", "a": "rad", "b": "rad", "c": "rad"}
+_MEANINGS = {
+    "x": "platform origin, world x",
+    "y": "platform origin, world y",
+    "z": "platform origin, world z",
+    "a": "platform orientation R = Rz(c) Ry(b) Rx(a): angle about x",
+    "b": "platform orientation: angle about y",
+    "c": "platform orientation: angle about z",
+}
+
+
+def pose_arguments(structure: SpatialStructure) -> tuple[Argument, Argument, Argument]:
+    """``q``, ``qd``, ``qdd``: the pose (docs/spatial-robots.md), its rates and accelerations."""
+    q, qd, qdd = pose_symbols(structure)
+    names = structure.pose
+    return (
+        Argument(
+            "q",
+            q,
+            tuple(Component(n, _UNITS[n], _MEANINGS[n]) for n in names),
+            "platform pose: origin (m)" + (", angles (rad)" if structure.dof == 6 else ""),
+        ),
+        Argument(
+            "qd",
+            qd,
+            tuple(Component(f"d{n}", f"{_UNITS[n]}/s", f"d({n})/dt") for n in names),
+            "its time derivative",
+        ),
+        Argument(
+            "qdd",
+            qdd,
+            tuple(Component(f"dd{n}", f"{_UNITS[n]}/s^2", f"d2({n})/dt2") for n in names),
+            "its second time derivative",
+        ),
+    )
+
+
+def params_argument(structure: SpatialStructure) -> Argument:
+    names = param_names(structure)
+    return Argument(
+        name="params",
+        symbols=tuple(param(n) for n in names),
+        components=tuple(Component(n, *param_doc(n)) for n in names),
+        doc="model parameters",
+        table="param_names",
+    )
+
+
+@cache
+def _derivation(structure: SpatialStructure) -> virtual_work.InverseDynamics:
+    return virtual_work.derive(structure)
+
+
+def _checks(derivation: virtual_work.InverseDynamics) -> tuple[Check, ...]:
+    return (
+        Check("inputs_not_finite", "NOT_FINITE"),
+        Check(
+            "below", "SINGULAR", threshold="MIN_REACH", guard=("reach", sp.Min(*derivation.reaches))
+        ),
+        Check(
+            "below",
+            "SINGULAR",
+            threshold="MIN_CONDITIONING",
+            guard=("conditioning", derivation.outputs["conditioning"]),
+        ),
+        Check("outputs_not_finite", "SINGULAR"),
+    )
+
+
+def _unit(name: str, structure: SpatialStructure) -> tuple[str, str]:
+    family, _, leg = name.rpartition("_")
+    if name == "conditioning":
+        return "1", "closeness to a parallel singularity: 1 at best, 0 singular"
+    head = family.rstrip("0123456789xyzab")
+    joint = "".join(ch for ch in family if ch.isdigit())
+    where = f"leg {leg}, joint {joint}"
+    if family == "tau":
+        unit = "N m" if structure.actuated_kind == "R" else "N"
+        return unit, f"actuator effort along its coordinate, leg {leg}"
+    if family[0] == "f":
+        return "N", f"force of the earlier body on the later, world {family[1]}, {where}"
+    if family[0] == "m":
+        return "N m", f"moment of the earlier body on the later about the joint, {where}"
+    kind = structure.kinds[int(joint) - 1] if not structure.delta or joint == "1" else "S"
+    unit = "m" if kind == "P" else "rad"
+    deriv = {"q": "", "qd": "/s", "qdd": "/s^2"}[head]
+    return unit + deriv, f"joint coordinate {family}, {where}"
+
+
+def inverse_dynamics(structure: SpatialStructure) -> FunctionSpec:
+    """``rpr3_inverse_dynamics``: leg kinematics and every joint load of a spatial robot."""
+    d = _derivation(structure)
+    return FunctionSpec(
+        name="inverse_dynamics",
+        doc=f"Inverse dynamics of the {structure.title}: every joint's coordinates and load "
+        "(the wrench the earlier body exerts on the later, world axes, moments about the "
+        "joint's point) and the actuator efforts tau, from the platform pose q, its rates qd "
+        "and accelerations qdd (docs/spatial-robots.md).",
+        inputs=pose_arguments(structure),
+        outputs=(
+            Output(
+                "out",
+                tuple(d.outputs.values()),
+                tuple(Component(n, *_unit(n, structure)) for n in d.outputs),
+                "row k receives OUTPUT_NAMES[k]",
+                table="output_names",
+            ),
+        ),
+        program=d.program,
+        checks=_checks(d),
+    )
+
+
+def actuator_coordinates(structure: SpatialStructure) -> FunctionSpec:
+    """``rpr3_actuator_coordinates``: the actuated joints' coordinates of a pose."""
+    d = _derivation(structure)
+    q = pose_arguments(structure)[0]
+    unit = "rad" if structure.actuated_kind == "R" else "m"
+    family = f"q{structure.actuated}"
+    return FunctionSpec(
+        name="actuator_coordinates",
+        doc=f"Actuator coordinates qa ({family} of every leg) of the platform pose q, each leg "
+        "in its working mode.",
+        inputs=(q,),
+        outputs=(
+            Output(
+                "qa",
+                d.actuators,
+                tuple(Component(f"{family}_{leg}", unit, f"leg {leg}") for leg in structure.legs),
+                f"actuator coordinates ({family} of legs {', '.join(structure.legs)})",
+            ),
+        ),
+        program=d.program,
+        checks=_checks(d),
+    )
+
+
+def pose_diagnostics(structure: SpatialStructure) -> FunctionSpec:
+    """``rpr3_pose_diagnostics``: each leg's reach and the conditioning, with no check."""
+    d = _derivation(structure)
+    q = pose_arguments(structure)[0]
+    return FunctionSpec(
+        name="pose_diagnostics",
+        doc="Diagnostics of a pose, with no failure check: each leg's reach (1 at home, 0 at "
+        "a serial singularity; NaN out of reach) and the conditioning (0 at a parallel "
+        "singularity).",
+        inputs=(q,),
+        outputs=(
+            Output(
+                "diagnostics",
+                (*d.reaches, d.outputs["conditioning"]),
+                (
+                    *(
+                        Component(f"reach_{leg}", "1", f"leg {leg}'s reach")
+                        for leg in structure.legs
+                    ),
+                    Component("conditioning", "1", "closeness to a parallel singularity"),
+                ),
+                "reach of every leg, then conditioning",
+            ),
+        ),
+        program=d.program,
+        checks=(Check("inputs_not_finite", "NOT_FINITE"),),
+    )
+
+
+def _qa(structure: SpatialStructure, d: virtual_work.InverseDynamics) -> Output:
+    unit = "rad" if structure.actuated_kind == "R" else "m"
+    family = f"q{structure.actuated}"
+    return Output(
+        "qa",
+        d.actuators,
+        tuple(Component(f"{family}_{leg}", unit, f"leg {leg}") for leg in structure.legs),
+        f"actuator coordinates ({family} of legs {', '.join(structure.legs)})",
+    )
+
+
+def _matrix(name: str, m: sp.Matrix, rows: list[str], cols: list[str], doc: str) -> Output:
+    return Output(
+        name,
+        tuple(m[i, j] for i in range(m.rows) for j in range(m.cols)),
+        tuple(
+            Component(f"{name}{i + 1}{j + 1}", "", f"d {rows[i]} / d {cols[j]}")
+            for i in range(m.rows)
+            for j in range(m.cols)
+        ),
+        doc,
+    )
+
+
+def _qa_names(structure: SpatialStructure) -> list[str]:
+    return [f"q{structure.actuated}_{leg}" for leg in structure.legs]
+
+
+def actuator_jacobian(structure: SpatialStructure) -> FunctionSpec:
+    """``rpr3_actuator_jacobian``: ``J = d qa / d q``, row-major (one row per leg)."""
+    d = _derivation(structure)
+    return FunctionSpec(
+        name="actuator_jacobian",
+        doc="Actuator Jacobian J = d qa / d q, row-major, one row per leg: qa' = J q'. det J = 0 "
+        "at a parallel singularity.",
+        inputs=(pose_arguments(structure)[0],),
+        outputs=(
+            _matrix(
+                "J",
+                d.jacobian,
+                _qa_names(structure),
+                list(structure.pose),
+                "J = d qa / d q, row-major",
+            ),
+        ),
+        program=d.program,
+        checks=_checks(d),
+    )
+
+
+def actuator_coordinates_jacobian(structure: SpatialStructure) -> FunctionSpec:
+    """``rpr3_actuator_coordinates_jacobian``: ``qa`` and ``J`` in one call."""
+    d = _derivation(structure)
+    return FunctionSpec(
+        name="actuator_coordinates_jacobian",
+        doc="Actuator coordinates qa of the pose q and the actuator Jacobian J = d qa / d q "
+        "there (row-major), in one call: what the forward kinematics' Newton evaluates.",
+        inputs=(pose_arguments(structure)[0],),
+        outputs=(
+            _qa(structure, d),
+            _matrix(
+                "J",
+                d.jacobian,
+                _qa_names(structure),
+                list(structure.pose),
+                "J = d qa / d q, row-major",
+            ),
+        ),
+        program=d.program,
+        checks=_checks(d),
+    )
+
+
+def _efforts(structure: SpatialStructure) -> Argument:
+    unit = "N m" if structure.actuated_kind == "R" else "N"
+    return Argument(
+        "tau",
+        tuple(sp.Symbol(f"tau_{leg}", real=True) for leg in structure.legs),
+        tuple(
+            Component(f"tau_{leg}", unit, f"actuator effort, leg {leg}") for leg in structure.legs
+        ),
+        "actuator efforts",
+    )
+
+
+def _c_context(structure: SpatialStructure, forward: bool = False) -> tuple:
+    d = _derivation(structure)
+    names = list(d.outputs)
+    params = param_names(structure)
+    return (
+        ("k", structure.dof),
+        ("outputs", len(names)),
+        ("tau", [names.index(f"tau_{leg}") for leg in structure.legs]),
+        ("loads", [params.index(n) for n in LOAD_PARAMS]),
+        ("params", len(params)),
+        ("forward", forward),
+    )
+
+
+#: The parameters of the loads that do not come from the motion: gravity and the payload.
+LOAD_PARAMS = ("gx", "gy", "gz", "fx", "fy", "fz", "mx", "my", "mz")
+
+
+def actuator_efforts(structure: SpatialStructure) -> FunctionSpec:
+    """``rpr3_actuator_efforts``: the efforts alone of the inverse dynamics (C: its kernel)."""
+    tau = _efforts(structure)
+    return FunctionSpec(
+        name="actuator_efforts",
+        doc="Actuator efforts tau that produce the platform acceleration qdd at (q, qd): the "
+        "inverse dynamics' efforts alone (the computed-torque law's efforts for a commanded "
+        "qdd).",
+        inputs=pose_arguments(structure),
+        outputs=(
+            Output(
+                "tau", (sp.Integer(0),) * len(structure.legs), tau.components, "actuator efforts"
+            ),
+        ),
+        program=Program(),
+        checks=(Check("inputs_not_finite", "NOT_FINITE"), Check("custom", "SINGULAR")),
+        c_body="spatial_efforts.c.jinja",
+        c_context=_c_context(structure),
+    )
+
+
+def task_space_dynamics(structure: SpatialStructure) -> FunctionSpec:
+    """``rpr3_task_space_dynamics``: ``M`` (row-major) and ``c``, ``M q'' + c = J^T tau``.
+
+    The efforts are affine in the acceleration, ``tau = T q'' + tau0``: ``tau0`` is the inverse
+    dynamics at ``q'' = 0``, ``T``'s column ``j`` the inverse dynamics at ``q'' = e_j`` with the
+    platform at rest and no gravity nor payload; ``M = J^T T``, ``c = J^T tau0``
+    (``templates/spatial_task_space.c.jinja``; the runtime composes the same in NumPy).
+    """
+    names = list(structure.pose)
+    k = structure.dof
+    return FunctionSpec(
+        name="task_space_dynamics",
+        doc="Dynamics in control form, M q'' + c = J^T tau in the pose's coordinates: M "
+        "(row-major, symmetric positive definite) and c (Coriolis and centripetal terms, "
+        "gravity, payload), from k + 1 evaluations of the inverse dynamics (its efforts are "
+        "affine in q'').",
+        inputs=pose_arguments(structure)[:2],
+        outputs=(
+            _matrix(
+                "M", sp.zeros(k, k), names, [f"dd{n}" for n in names], "mass matrix, row-major"
+            ),
+            Output(
+                "c",
+                (sp.Integer(0),) * k,
+                tuple(Component(f"c_{n}", "", f"bias along {n}") for n in names),
+                "bias forces",
+            ),
+        ),
+        program=Program(),
+        checks=(Check("inputs_not_finite", "NOT_FINITE"), Check("custom", "SINGULAR")),
+        c_body="spatial_task_space.c.jinja",
+        c_context=_c_context(structure),
+    )
+
+
+def forward_dynamics(structure: SpatialStructure) -> FunctionSpec:
+    """``rpr3_forward_dynamics``: ``q''`` under the efforts ``tau``: ``T q'' = tau - tau0``
+    (:func:`task_space_dynamics`' terms), by Gaussian elimination with partial pivoting."""
+    tau = _efforts(structure)
+    acc = pose_arguments(structure)[2]
+    return FunctionSpec(
+        name="forward_dynamics",
+        doc="Forward dynamics: the platform acceleration q'' = M^-1 (J^T tau - c) under the "
+        "actuator efforts tau, solved as T q'' = tau - tau0 (the inverse dynamics' efforts are "
+        "tau = T q'' + tau0).",
+        inputs=(*pose_arguments(structure)[:2], tau),
+        outputs=(
+            Output(
+                "qdd", (sp.Integer(0),) * structure.dof, acc.components, "platform acceleration"
+            ),
+        ),
+        program=Program(),
+        checks=(Check("inputs_not_finite", "NOT_FINITE"), Check("custom", "SINGULAR")),
+        c_body="spatial_task_space.c.jinja",
+        c_context=_c_context(structure, forward=True),
+    )
+
+
+#: The tracked forward kinematics' numbers: Newton steps, halvings of a step, convergence on
+#: the largest residual |qa(q) - qa| (rad or m).
+FK_TUNING: tuple[tuple[str, object], ...] = (("max_iter", 30), ("max_halvings", 30),
+                                             ("tol", "1e-12"))  # fmt: skip
+
+
+def forward_kinematics(structure: SpatialStructure) -> FunctionSpec:
+    """``rpr3_forward_kinematics``: the pose of the actuator coordinates ``qa`` that Newton
+    reaches from the reference pose ``q_near`` (``templates/spatial_forward_kinematics.c.jinja``;
+    the runtime's NumPy version is the same iteration)."""
+    q = pose_arguments(structure)[0]
+    d = _derivation(structure)
+    qa = _qa(structure, d)
+    qa_arg = Argument(
+        "qa",
+        tuple(sp.Symbol(f"qa_{leg}", real=True) for leg in structure.legs),
+        qa.components,
+        qa.doc,
+    )
+    near = Argument(
+        "q_near",
+        tuple(sp.Symbol(f"{c.name}_near", real=True) for c in q.components),
+        q.components,
+        "the reference pose: the previous solution, or a prediction from the last two",
+    )
+    return FunctionSpec(
+        name="forward_kinematics",
+        doc="Tracked forward kinematics: the pose q with actuator coordinates qa, found by "
+        "Newton from the reference pose q_near (the step halved until the largest residual "
+        "decreases, at most 30 steps, converged at 1e-12 rad or m); NO_MODE when it does not "
+        "converge.",
+        inputs=(qa_arg, near),
+        outputs=(Output("q", (sp.Integer(0),) * structure.dof, q.components, "the pose found"),),
+        program=Program(),
+        checks=(Check("inputs_not_finite", "NOT_FINITE"), Check("custom", "NO_MODE")),
+        c_body="spatial_forward_kinematics.c.jinja",
+        c_kernels=("rint",) if structure.actuated_kind == "R" else (),
+        c_context=(("k", structure.dof), ("wrap", structure.actuated_kind == "R"), *FK_TUNING),
+    )
+
+
+FunctionBuilder = Callable[[SpatialStructure], FunctionSpec | None]
+
+FUNCTIONS: Mapping[str, FunctionBuilder] = {
+    "inverse_dynamics": inverse_dynamics,
+    "actuator_coordinates": actuator_coordinates,
+    "pose_diagnostics": pose_diagnostics,
+    "actuator_jacobian": actuator_jacobian,
+    "actuator_coordinates_jacobian": actuator_coordinates_jacobian,
+    "actuator_efforts": actuator_efforts,
+    "task_space_dynamics": task_space_dynamics,
+    "forward_dynamics": forward_dynamics,
+    "forward_kinematics": forward_kinematics,
+}
+
+
+def module(
+    structure: SpatialStructure, functions: Mapping[str, FunctionBuilder] | None = None
+) -> ModuleSpec:
+    """The generated module of one spatial structure."""
+    functions = FUNCTIONS if functions is None else functions
+    return ModuleSpec(
+        prefix=PREFIX,
+        variant=structure.variant,
+        doc=f"Generated functions of the {structure.title} spatial parallel robot, in the "
+        "model file's parameters. Model numbers are inputs (params), so one build serves every "
+        "robot of this structure.",
+        params=params_argument(structure),
+        functions=tuple(spec for b in functions.values() if (spec := b(structure)) is not None),
+        return_codes=RETURN_CODES,
+        thresholds=THRESHOLDS,
+        defines=(
+            ("LEG", f'"{structure.kinds}"', "leg type, base to platform"),
+            ("ACTUATED", str(structure.actuated), "the joint of every leg that carries its motor"),
+            ("NUM_LEGS", str(len(structure.legs)), "legs"),
+            ("DOF", str(structure.dof), "the platform's degrees of freedom (size of q)"),
+        ),
+    )
+
+
+def clear_cache() -> None:
+    """Forget the derivations made so far (they are made once per process otherwise)."""
+    _derivation.cache_clear()
+
+
+__all__ = ["FUNCTIONS", "Program", "module"]

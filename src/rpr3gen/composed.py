@@ -1,0 +1,158 @@
+"""The NumPy versions of the spatial robots' hand-written C functions, composed from the
+generated ones: the efforts, the control form, the forward dynamics and the tracked forward
+kinematics (docs/spatial-robots.md).
+
+The inverse dynamics' efforts are affine in the platform's acceleration, ``tau = T q'' +
+tau0``: ``tau0`` is the inverse dynamics at ``q'' = 0`` and column ``j`` of ``T`` the inverse
+dynamics at ``q'' = e_j`` with the platform at rest, without gravity and payload (their
+parameters zeroed). Then ``M = J^T T``, ``c = J^T tau0``, and the forward dynamics solves
+``T q'' = tau - tau0``: what the generated C bodies compute, sample by sample. A failed sample
+is a row of NaN, as the C batch writes it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+
+import numpy as np
+
+from rpr3gen.manifest import FunctionInfo, Variant
+
+#: ``run(function name, params, inputs) -> outputs (n, size) each``: the generated NumPy code.
+Runner = Callable[[str, np.ndarray, Sequence[np.ndarray]], list[np.ndarray]]
+
+COMPOSED: tuple[str, ...] = (
+    "actuator_efforts",
+    "task_space_dynamics",
+    "forward_dynamics",
+    "forward_kinematics",
+)
+
+#: The parameters of the loads that do not come from the motion: gravity and the payload.
+LOAD_PARAMS = ("gx", "gy", "gz", "fx", "fy", "fz", "mx", "my", "mz")
+#: The tracked forward kinematics' numbers (the generated C's: derive/spatial/registry.py).
+MAX_ITER, MAX_HALVINGS, TOL = 30, 30, 1e-12
+
+
+def composable(variant: Variant, function: FunctionInfo) -> bool:
+    """Whether ``function`` of ``variant`` has a NumPy composition here."""
+    return function.name in COMPOSED and "DOF" in variant.defines
+
+
+def run(
+    variant: Variant,
+    function: FunctionInfo,
+    params: np.ndarray,
+    inputs: Sequence[np.ndarray],
+    outputs: Sequence[np.ndarray],
+    generated: Runner,
+) -> None:
+    """Evaluate ``function`` into ``outputs`` (each (n, size)); failed samples are NaN rows."""
+    tau_rows = _tau_rows(variant)
+    if function.name == "forward_kinematics":
+        outputs[0][:] = _forward_kinematics(params, inputs[0], inputs[1], generated, variant)
+        return
+    q = inputs[0]
+    n, k = q.shape
+    zero = np.zeros_like(q)
+    if function.name == "actuator_efforts":
+        (out,) = generated("inverse_dynamics", params, inputs)
+        outputs[0][:] = out[:, tau_rows]
+        return
+    (out,) = generated("inverse_dynamics", params, [q, inputs[1], zero])
+    tau0 = out[:, tau_rows]
+    T = _efforts_matrix(variant, params, q, generated, tau_rows)
+    if function.name == "task_space_dynamics":
+        (J,) = generated("actuator_jacobian", params, [q])
+        J = J.reshape(n, k, k)
+        Jt = np.swapaxes(J, 1, 2)
+        outputs[0][:] = (Jt @ T).reshape(n, k * k)
+        outputs[1][:] = (Jt @ tau0[:, :, np.newaxis])[:, :, 0]
+        return
+    rhs = inputs[2] - tau0
+    result = np.full((n, k), np.nan)
+    ok = np.isfinite(T).all(axis=(1, 2)) & np.isfinite(rhs).all(axis=1)
+    if ok.any():
+        with np.errstate(all="ignore"):
+            solved = np.linalg.solve(T[ok], rhs[ok][:, :, np.newaxis])[:, :, 0]
+        result[ok] = solved
+    result[~np.isfinite(result).all(axis=1)] = np.nan
+    outputs[0][:] = result
+
+
+def _tau_rows(variant: Variant) -> list[int]:
+    names = variant.function("inverse_dynamics").outputs[0].names
+    legs = [n.rpartition("_")[2] for n in names if n.startswith("tau_")]
+    return [names.index(f"tau_{leg}") for leg in legs]
+
+
+def _efforts_matrix(
+    variant: Variant, params: np.ndarray, q: np.ndarray, generated: Runner, rows: list[int]
+) -> np.ndarray:
+    """``T = d tau / d q''`` per sample, (n, k, k)."""
+    n, k = q.shape
+    p0 = params.copy()
+    for name in LOAD_PARAMS:
+        p0[variant.param_names.index(name)] = 0.0
+    zero = np.zeros_like(q)
+    T = np.empty((n, k, k))
+    for j in range(k):
+        unit = np.zeros_like(q)
+        unit[:, j] = 1.0
+        (out,) = generated("inverse_dynamics", p0, [q, zero, unit])
+        T[:, :, j] = out[:, rows]
+    return T
+
+
+def _forward_kinematics(
+    params: np.ndarray,
+    qa: np.ndarray,
+    near: np.ndarray,
+    generated: Runner,
+    variant: Variant,
+) -> np.ndarray:
+    """Newton from ``near`` with the step halved until the largest residual decreases."""
+    leg = variant.defines.get("LEG", '""').strip('"')
+    wrap = leg[int(variant.defines.get("ACTUATED", "1")) - 1] == "R"
+    n, k = qa.shape
+    result = np.full((n, k), np.nan)
+
+    def residual(q: np.ndarray, target: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+        value, J = generated("actuator_coordinates_jacobian", params, [q[np.newaxis]])
+        if not (np.isfinite(value).all() and np.isfinite(J).all()):
+            return None
+        r = value[0] - target
+        if wrap:
+            r = r - 2 * np.pi * np.rint(r / (2 * np.pi))
+        return r, J[0].reshape(k, k)
+
+    for s in range(n):
+        if not (np.isfinite(qa[s]).all() and np.isfinite(near[s]).all()):
+            continue
+        q = near[s].copy()
+        first = residual(q, qa[s])
+        if first is None:
+            continue
+        r, J = first
+        worst = float(np.max(np.abs(r)))
+        for _ in range(MAX_ITER):
+            if worst <= TOL:
+                break
+            try:
+                dq = np.linalg.solve(J, r)
+            except np.linalg.LinAlgError:
+                break
+            step, accepted = 1.0, False
+            for _ in range(MAX_HALVINGS + 1):
+                trial = q - step * dq
+                found = residual(trial, qa[s])
+                if found is not None and float(np.max(np.abs(found[0]))) < worst:
+                    q, (r, J), accepted = trial, found, True
+                    worst = float(np.max(np.abs(r)))
+                    break
+                step *= 0.5
+            if not accepted:
+                break
+        if worst <= TOL:
+            result[s] = q
+    return result
