@@ -1,5 +1,6 @@
 """Spatial robots' C timings (one run, on demand): single call and batch of the inverse dynamics,
-the forward dynamics and the tracked forward kinematics of the committed 6-UPS and Delta.
+the forward dynamics and the tracked forward kinematics of the committed 6-UPS and Delta, and
+MuJoCo's ``mj_forward`` on the same robots (``rpr3gen export``), the peer.
 
     python benchmarks/spatial.py            # prints a Markdown table and the machine
 
@@ -126,6 +127,31 @@ def measure(model_file: str, trajectory: str) -> dict[str, float]:
     return {line.split()[0]: float(line.split()[1]) for line in result.stdout.splitlines()}
 
 
+def mj_forward_ns(model_file: str, steps: int = 20000) -> float:
+    """MuJoCo's cost of one ``mj_forward`` on the exported robot: ``steps`` semi-implicit
+    Euler steps (one forward pass each, and an update of the state) run in C by
+    ``mujoco.rollout`` from home at rest, the time divided by the steps (median of 5)."""
+    import time
+
+    import mujoco
+    from mujoco import rollout
+
+    from rpr3gen.export import mjcf
+
+    model = rpr3gen.load_model(ROOT / "models" / model_file)
+    mm = mujoco.MjModel.from_xml_string(mjcf(model))
+    mm.opt.integrator = mujoco.mjtIntegrator.mjINT_EULER
+    data = mujoco.MjData(mm)
+    state = np.zeros((1, mujoco.mj_stateSize(mm, mujoco.mjtState.mjSTATE_FULLPHYSICS)))
+    mujoco.mj_getState(mm, data, state[0], mujoco.mjtState.mjSTATE_FULLPHYSICS)
+    times = []
+    for _ in range(5):
+        t0 = time.perf_counter()
+        rollout.rollout(mm, data, state, nstep=steps)
+        times.append((time.perf_counter() - t0) / steps)
+    return float(np.median(times)) * 1e9
+
+
 def main() -> int:
     print(f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
           f"load {os.getloadavg()[0]:.2f}")  # fmt: skip
@@ -135,12 +161,17 @@ def main() -> int:
         print(f"cpu: {cpu}")
     except (OSError, StopIteration):
         pass
-    print("| robot | ID single (ns) | ID batch (ns/sample) | FD single (ns) | tracked FK (ns) |")
-    print("|---|---|---|---|---|")
+    print(
+        "| robot | ID single (ns) | ID batch (ns/sample) | FD single (ns) | tracked FK (ns) "
+        "| mj_forward (ns) |"
+    )
+    print("|---|---|---|---|---|---|")
     for model, traj in (("tsai-ups.toml", "tsai-ups.csv"), ("delta.toml", "delta.csv")):
         r = measure(model, traj)
-        print(f"| {model[:-5]} | {r['inverse_dynamics']:.0f} | {r['inverse_dynamics_batch']:.0f} "
-              f"| {r['forward_dynamics']:.0f} | {r['forward_kinematics']:.0f} |")  # fmt: skip
+        mj = mj_forward_ns(model)
+        cells = [r["inverse_dynamics"], r["inverse_dynamics_batch"], r["forward_dynamics"]]
+        cells += [r["forward_kinematics"], mj]
+        print(f"| {model[:-5]} | " + " | ".join(f"{c:.0f}" for c in cells) + " |")
     return 0
 
 

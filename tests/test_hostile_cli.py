@@ -29,6 +29,9 @@ from rpr3gen.cli import main
 from rpr3gen.excitation import FourierMotion
 from rpr3gen.parameters import inertial_parameters
 
+ROOT = Path(__file__).resolve().parent.parent
+DELTA = str(ROOT / "models" / "delta.toml")
+
 # -- the options' values ------------------------------------------------------------------
 
 
@@ -195,6 +198,12 @@ COMMANDS: tuple[Command, ...] = (
             "--min-conditioning": CONDITIONING,
         },
         outputs={"--out": True},
+        inputs={"--model": "model"},
+    ),
+    Command(
+        "export",
+        lambda tmp: ["export", "--model", DELTA, "--out", str(tmp / "delta.xml")],
+        outputs={"--out": False},
         inputs={"--model": "model"},
     ),
     Command(

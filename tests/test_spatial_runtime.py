@@ -166,7 +166,6 @@ def test_generate_refuses_a_wrong_actuated_joint(capsys: pytest.CaptureFixture) 
     "command",
     [
         ["workspace", "--out", "w.parquet"],
-        ["params"],
         ["animate", "--trajectory", "models/delta.csv", "--out", "a.gif"],
         ["identify", "--data", "models/delta.csv"],
         ["excite", "--out", "e.csv"],
@@ -183,6 +182,14 @@ def test_commands_not_yet_spatial_refuse_in_one_line(
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1
     assert "not available for spatial robots yet" in err
+
+
+def test_params_prints_the_spatial_parameter_vector(capsys: pytest.CaptureFixture) -> None:
+    assert main(["params", "--model", str(ROOT / "models" / "delta.toml")]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    model = _model("delta")
+    assert [line.split()[0] for line in lines] == list(model.param_names)
+    assert [float(line.split()[1]) for line in lines] == list(model.vector())
 
 
 def test_the_python_api_refuses_what_is_not_spatial_yet() -> None:

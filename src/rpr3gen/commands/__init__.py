@@ -12,6 +12,7 @@ from __future__ import annotations
 from rpr3gen.commands import (
     animate,
     excite,
+    export,
     fk,
     generate,
     identify,
@@ -22,5 +23,17 @@ from rpr3gen.commands import (
     workspace,
 )
 
-COMMANDS = (simulate, paper, params, fk, identify, excite, animate, workspace, sweep, generate)
+COMMANDS = (
+    simulate,
+    paper,
+    params,
+    fk,
+    identify,
+    excite,
+    animate,
+    workspace,
+    sweep,
+    export,
+    generate,
+)
 """Every command module, in the order of ``rpr3gen --help``."""

@@ -6,7 +6,6 @@ import argparse
 
 from rpr3gen.commands import options
 from rpr3gen.model import load_model
-from rpr3gen.structure import planar_only
 
 NAME = "params"
 
@@ -22,7 +21,6 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     """Print every parameter, full precision."""
     model = load_model(args.model)
-    planar_only(model.structure, "rpr3gen params")
     lines = [f"{name} {value:.17g}" for name, value in model.params.items()]
     print("\n".join(lines))
     return 0
