@@ -99,10 +99,18 @@ def test_fk_prints_the_delta_modes(capsys: pytest.CaptureFixture) -> None:
     code = main(["fk", "--model", str(ROOT / "models" / "delta.toml"),
                  *(repr(float(v)) for v in qa)])  # fmt: skip
     assert code == 0
-    lines = [line for line in capsys.readouterr().out.splitlines() if not line.startswith("#")]
+    text = capsys.readouterr().out.splitlines()
+    lines = [line for line in text if not line.startswith("#")]
     poses = np.array([[float(v) for v in line.split()[:3]] for line in lines])
     assert len(poses) >= 1
     assert np.min(np.abs(poses - q).max(axis=1)) < 1e-9
+    # the other sphere intersection, as a comment: every rod at its length, legs elsewhere
+    others = [line[2:].split() for line in text[1:] if line.startswith("# ") and "(" not in line]
+    assert len(poses) + len(others) == 2
+    for other in others:
+        o = np.array([float(v) for v in other])
+        back = control.actuator_coordinates(model, o)[0]
+        assert not (np.isfinite(back).all() and np.abs(back - qa).max() < 1e-9)
 
 
 def test_delta_modes_are_both_sphere_intersections_in_the_working_mode() -> None:

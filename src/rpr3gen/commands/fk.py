@@ -26,7 +26,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         "line: x y (m) phi (rad, in (-pi, pi]) and the pose's conditioning (0 = singular, 1 = "
         "best). A spatial robot takes one reading per leg (a hexapod six, a Delta three) and "
         "prints x y z (m) and, for a hexapod, a b c (rad); a Delta's modes in closed form, a "
-        "hexapod's those its documented search finds (docs/spatial-robots.md).",
+        "hexapod's those its documented search finds; a Delta's other sphere intersection, with "
+        "legs in the other working mode, follows as a comment line (docs/spatial-robots.md).",
     )
     options.add_model(parser)
     options.add_generated(parser)
@@ -61,4 +62,17 @@ def run(args: argparse.Namespace) -> int:
     )
     for mode, c in zip(modes, conditioning, strict=True):
         print(" ".join(f"{v:.12g}" for v in mode) + f" {c:.6g}")
+    if model.structure.spatial and model.structure.dof == 3:
+        from rpr3gen.spatial_modes import delta_candidates
+
+        others = [
+            c for c in delta_candidates(model, qa) if not any(np.allclose(c, m) for m in modes)
+        ]
+        if others:
+            print(
+                f"# {len(others)} other assembly mode(s), with legs in the other working mode "
+                "(not the model's; x y z):"
+            )
+        for c in others:
+            print("# " + " ".join(f"{v:.12g}" for v in c))
     return 0
