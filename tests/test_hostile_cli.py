@@ -195,6 +195,7 @@ COMMANDS: tuple[Command, ...] = (
         numbers={
             "--phi": Numeric(),
             "--resolution": Numeric(whole=True, least=2, size=True),
+            "--heights": Numeric(whole=True, least=1),
             "--min-conditioning": CONDITIONING,
         },
         outputs={"--out": True},

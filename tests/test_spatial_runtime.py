@@ -173,7 +173,6 @@ def test_generate_refuses_a_wrong_actuated_joint(capsys: pytest.CaptureFixture) 
 @pytest.mark.parametrize(
     "command",
     [
-        ["workspace", "--out", "w.parquet"],
         ["animate", "--trajectory", "models/delta.csv", "--out", "a.gif"],
         ["identify", "--data", "models/delta.csv"],
         ["excite", "--out", "e.csv"],

@@ -4,15 +4,16 @@
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
 import numpy as np
 
 from rpr3gen.commands import options
 from rpr3gen.commands.args import integer, number
 from rpr3gen.design.maps import DEFAULT_RESOLUTION, WorkspaceMap
-from rpr3gen.model import load_model
+from rpr3gen.errors import InputError
+from rpr3gen.model import Model, load_model
 from rpr3gen.paths import check_output
-from rpr3gen.structure import planar_only
 
 NAME = "workspace"
 
@@ -42,8 +43,35 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         metavar="N",
         help=f"grid points along x and along y (default: {DEFAULT_RESOLUTION})",
     )
+    parser.add_argument(
+        "--heights",
+        type=integer(1),
+        default=9,
+        metavar="K",
+        help="spatial robots: horizontal slices of the box (default: 9)",
+    )
+    parser.add_argument(
+        "--orientation",
+        type=_three_angles,
+        default=(0.0, 0.0, 0.0),
+        metavar="A,B,C",
+        help="hexapods: the platform's fixed orientation (a, b, c), degrees, comma-separated "
+        "(default: 0,0,0)",
+    )
     options.add_out_folder(parser, "workspace")
     options.add_min_conditioning(parser, "poses below this conditioning are not reachable")
+
+
+def _three_angles(text: str) -> tuple[float, float, float]:
+    """``A,B,C``: three finite numbers (degrees)."""
+    parts = text.split(",")
+    try:
+        values = [float(p) for p in parts]
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not three numbers: {text!r}") from None
+    if len(values) != 3 or not all(np.isfinite(values)):
+        raise argparse.ArgumentTypeError(f"must be three finite angles A,B,C, got {text!r}")
+    return values[0], values[1], values[2]
 
 
 def run(args: argparse.Namespace) -> int:
@@ -51,14 +79,42 @@ def run(args: argparse.Namespace) -> int:
     from rpr3gen.design import workspace, write_workspace
 
     model = load_model(args.model)
-
-    planar_only(model.structure, "rpr3gen workspace")
     out = check_output(args.out, "the workspace maps", folder=True, argument="out")
+    if model.structure.spatial:
+        return _spatial(args, model, out)
     wmap = workspace(model, np.radians(args.phi), args.resolution,
                      min_conditioning=args.min_conditioning)  # fmt: skip
     written = write_workspace(wmap, out)
     print(_summary(wmap))
     print(f"wrote {written[0]} and {len(written) - 1} figures in {out}")
+    return 0
+
+
+def _spatial(args: argparse.Namespace, model: Model, out: Path) -> int:
+    """The constant-orientation workspace of a spatial robot: slices, volume, Parquet, PNG."""
+    from rpr3gen.design.spatial_workspace import spatial_workspace, write_spatial_workspace
+
+    if model.structure.dof == 3 and any(args.orientation):
+        raise InputError("--orientation: a Delta's platform keeps its home orientation")
+    if args.phi:
+        raise InputError("--phi: for planar robots; a hexapod takes --orientation A,B,C")
+    a, b, c = (float(v) for v in np.radians(args.orientation))
+    angles = (a, b, c)
+    ws = spatial_workspace(
+        model, args.resolution, args.heights, angles, min_conditioning=args.min_conditioning
+    )
+    written = write_spatial_workspace(ws, out)
+    reachable = int(np.count_nonzero(ws.reachable))
+    peak = float(np.nanmax(np.abs(ws.tau), initial=0.0))
+    print(
+        f"workspace of {model.name} ({model.structure.title}): {ws.x.size} x {ws.y.size} x "
+        f"{ws.z.size} points over x, y, z in [{ws.x[0]:.4g}, {ws.x[-1]:.4g}] m"
+    )
+    print(
+        f"  reachable: {reachable} points, volume {ws.volume:.5g} m^3 (conditioning >= "
+        f"{ws.min_conditioning:g}); peak static effort {peak:.5g}"
+    )
+    print(f"wrote {written[0]} and {written[1]}")
     return 0
 
 

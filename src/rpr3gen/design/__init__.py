@@ -13,6 +13,19 @@ count a pose reachable as :mod:`.reach` says (with its default limits for design
 
 from rpr3gen.design.maps import WorkspaceMap, workspace
 from rpr3gen.design.outputs import write_workspace
+from rpr3gen.design.spatial_workspace import (
+    SpatialWorkspace,
+    spatial_workspace,
+    write_spatial_workspace,
+)
 from rpr3gen.design.sweeps import sweep
 
-__all__ = ["WorkspaceMap", "sweep", "workspace", "write_workspace"]
+__all__ = [
+    "SpatialWorkspace",
+    "WorkspaceMap",
+    "spatial_workspace",
+    "sweep",
+    "workspace",
+    "write_spatial_workspace",
+    "write_workspace",
+]

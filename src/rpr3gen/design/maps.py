@@ -30,9 +30,9 @@ from rpr3gen.design.reach import (
     within,
 )
 from rpr3gen.design.stacked import evaluate_stacked, leg_lengths, piston_displacements
+from rpr3gen.errors import ModelError
 from rpr3gen.model import LEGS, Model
 from rpr3gen.policy import DEFAULT_MIN_CONDITIONING
-from rpr3gen.structure import planar_only
 from rpr3gen.validation import Integer, Number, checked
 
 __all__ = [
@@ -229,7 +229,11 @@ def workspace(
     Raises:
         InputError, InputTypeError: for a bad argument (:mod:`rpr3gen.validation`).
     """
-    planar_only(model.structure, "workspace")
+    if model.structure.spatial:
+        raise ModelError(
+            f"workspace: the {model.structure.title} is spatial; its constant-orientation "
+            "workspace is rpr3gen.design.spatial_workspace(model, ...)"
+        )
     params = model.vector()
     limits = design_limits(model)
     bound = bounds(limits)
