@@ -173,7 +173,6 @@ def test_generate_refuses_a_wrong_actuated_joint(capsys: pytest.CaptureFixture) 
 @pytest.mark.parametrize(
     "command",
     [
-        ["animate", "--trajectory", "models/delta.csv", "--out", "a.gif"],
         ["identify", "--data", "models/delta.csv"],
         ["excite", "--out", "e.csv"],
     ],
@@ -189,6 +188,26 @@ def test_commands_not_yet_spatial_refuse_in_one_line(
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1
     assert "not available for spatial robots yet" in err
+
+
+@pytest.mark.parametrize("name", ["tsai-ups", "delta"])
+def test_animate_draws_a_spatial_robot_in_3d(name: str, tmp_path: Path) -> None:
+    from PIL import Image
+
+    out = tmp_path / f"{name}.gif"
+    args = ["animate", "--model", str(ROOT / "models" / f"{name}.toml"), "--trajectory",
+            str(ROOT / "models" / f"{name}.csv"), "--out", str(out), "--fps", "4", "--size",
+            "240x240", "--loads"]  # fmt: skip
+    assert main(args) == 0
+    with Image.open(out) as movie:
+        assert movie.size == (240, 240)
+        frames = []
+        for k in range(movie.n_frames):
+            movie.seek(k)
+            frames.append(np.asarray(movie.convert("L")))
+    traj = _trajectory(name)
+    assert len(frames) == int((traj.t[-1] - traj.t[0]) * 4) + 1
+    assert any(np.any(f != frames[0]) for f in frames[1:])  # the robot moves
 
 
 def test_params_prints_the_spatial_parameter_vector(capsys: pytest.CaptureFixture) -> None:

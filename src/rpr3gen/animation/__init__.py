@@ -43,11 +43,12 @@ from rpr3gen.animation.frames import (
     plan,
 )
 from rpr3gen.animation.scene import Scene, scene
+from rpr3gen.animation.spatial import SpatialDrawing
 from rpr3gen.animation.writers import writer
 from rpr3gen.atomic import atomic_path
+from rpr3gen.backends import inverse_dynamics
 from rpr3gen.model import Model
 from rpr3gen.policy import DEFAULT_MIN_CONDITIONING
-from rpr3gen.structure import planar_only
 from rpr3gen.trajectory import Trajectory
 
 __all__ = [
@@ -67,6 +68,25 @@ __all__ = [
     "scene",
     "write_animation",
 ]
+
+
+def _spatial_drawing(
+    model: Model,
+    traj: Trajectory,
+    the_plan: Plan,
+    loads: bool,
+    title: str | None,
+    backend: str,
+    min_conditioning: float,
+) -> SpatialDrawing:
+    """A spatial robot's 3-D drawing, its trajectory refused where a pose is invalid (as
+    ``rpr3gen simulate`` refuses it)."""
+    from rpr3gen.simulation import screen
+
+    out = inverse_dynamics(model, traj.q, traj.qd, traj.qdd, backend=backend)
+    screen(model, traj, out, min_conditioning, allow_invalid=False)
+    heading = title or f"{model.name}: {model.structure.title}"
+    return SpatialDrawing(model, traj, out, the_plan.size, DPI, loads, heading)
 
 
 def write_animation(
@@ -108,12 +128,16 @@ def write_animation(
         Rpr3genError: For a trajectory through an invalid pose.
         OSError: If the file cannot be written.
     """
-    planar_only(model.structure, "animate")
     the_plan = plan(traj.t, out, fps=fps, speed=speed, size=size)
-    scn = scene(
-        model, traj, title=title, loads=loads, backend=backend, min_conditioning=min_conditioning
-    )
-    drawing = Drawing(scn, the_plan.size, the_plan.samples)
+    drawing: Drawing | SpatialDrawing
+    if model.structure.spatial:
+        drawing = _spatial_drawing(model, traj, the_plan, loads, title, backend, min_conditioning)
+    else:
+        scn = scene(
+            model, traj, title=title, loads=loads, backend=backend,
+            min_conditioning=min_conditioning,
+        )  # fmt: skip
+        drawing = Drawing(scn, the_plan.size, the_plan.samples)
     the_plan.path.parent.mkdir(parents=True, exist_ok=True)
     movie = writer(the_plan)
     with atomic_path(the_plan.path) as tmp, movie.saving(drawing.figure, tmp, dpi=DPI):

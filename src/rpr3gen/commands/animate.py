@@ -10,7 +10,6 @@ from rpr3gen.commands import options
 from rpr3gen.commands.args import integer, number
 from rpr3gen.model import load_model
 from rpr3gen.paths import check_output
-from rpr3gen.structure import planar_only
 
 NAME = "animate"
 
@@ -59,8 +58,7 @@ def run(args: argparse.Namespace) -> int:
     check_output(args.out, "the movie", argument="out")
     size = animation.parse_size(args.size)
     model = load_model(args.model)
-    planar_only(model.structure, "rpr3gen animate")
-    name, traj = options.trajectory(args)
+    name, traj = options.trajectory(args, model.structure.pose)
     animation.plan(traj.t, args.out, fps=args.fps, speed=args.speed, size=size)  # before work
     done = animation.write_animation(
         model, traj, args.out, fps=args.fps, speed=args.speed, size=size, loads=args.loads,
