@@ -483,3 +483,13 @@ def test_error_names_file_and_key(tmp_path: Path, case: str) -> None:
 def test_dict_source_is_named() -> None:
     with pytest.raises(ModelError, match=r"^<dict>: legs\.A\.width: "):
         model_from_dict(_edit("delta", legs__A__width=-1.0))
+
+
+def test_a_misspelt_spatial_leg_type_is_named_with_the_spatial_types() -> None:
+    from rpr3gen.errors import ModelError
+    from rpr3gen.model import model_from_dict
+
+    with pytest.raises(ModelError, match="did you mean 'RSS2'") as caught:
+        model_from_dict({"name": "x", "leg": "RSS", "actuated": 1})
+    assert "UPS, RUS, PUS, RSS2, PSS2" in str(caught.value)
+    assert "\n" not in str(caught.value)

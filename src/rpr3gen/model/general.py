@@ -41,7 +41,7 @@ import numpy as np
 from rpr3gen.errors import ModelError, did_you_mean
 from rpr3gen.model.reading import Reader, describe
 from rpr3gen.model.types import DEFAULT_GRAVITY, Model
-from rpr3gen.structure import LEG_TYPES, LEGS, Structure
+from rpr3gen.structure import LEG_TYPES, LEGS, SPATIAL_LEG_TYPES, Structure
 
 #: Allowed keys per table (None: a value; a dict: a sub-table).
 LEG_KEYS: tuple[str, ...] = ("joints", "axes", "mass", "com", "inertia")
@@ -156,11 +156,13 @@ class GeneralReader(Reader):
     def structure(self, data: Mapping[str, Any]) -> Structure:
         leg = self.required(data, "leg", "leg")
         if leg not in LEG_TYPES:
-            hint = did_you_mean(leg, LEG_TYPES) if isinstance(leg, str) else ""
+            every = (*LEG_TYPES, *SPATIAL_LEG_TYPES)
+            hint = did_you_mean(leg, every) if isinstance(leg, str) else ""
             self.fail(
                 "leg",
-                f"must be one of {', '.join(LEG_TYPES)} (joint types from base to platform; "
-                f"PPP cannot turn the platform), got {describe(leg)}{hint}",
+                f"must be one of {', '.join(LEG_TYPES)} (planar: joint types from base to "
+                f"platform; PPP cannot turn the platform) or {', '.join(SPATIAL_LEG_TYPES)} "
+                f"(spatial), got {describe(leg)}{hint}",
             )
         actuated = self.required(data, "actuated", "actuated")
         if isinstance(actuated, bool) or actuated not in (1, 2, 3):
