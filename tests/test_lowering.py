@@ -419,7 +419,7 @@ def test_the_legs_statements_run_as_one_call_for_three_legs(
     # output rows written at once and summed; a block of three rows is only ever three free
     # rows, and the row of a leg whose value is dead is free while the other legs' rows of its
     # block are still read (r_B dies at s, r_A and r_C live to h).
-    from rpr3gen_derive.codegen.backends.python import lowering
+    from rpr3gen_derive.codegen.backends.python import groups
 
     code, s = _legs_program()
     rng = np.random.default_rng(5)
@@ -448,7 +448,7 @@ def test_the_legs_statements_run_as_one_call_for_three_legs(
     np.testing.assert_allclose(got, want, rtol=1e-14, atol=1e-15)
     np.testing.assert_array_equal(sums, np.add.reduce(got, axis=1))
 
-    monkeypatch.setattr(lowering, "MIN_GROUPS", 10**6)  # the same program, leg by leg
+    monkeypatch.setattr(groups, "MIN_GROUPS", 10**6)  # the same program, leg by leg
     alone = lower_numpy(code, inputs, params, rows, {})
     assert not alone.triples
     # r, s, q (two operations) and p: five operations, each one call for three legs
