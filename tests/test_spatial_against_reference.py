@@ -260,3 +260,20 @@ def test_at_rest_the_base_holds_the_weight(leg: str) -> None:
     payload = np.array(data.get("payload", {}).get("force", (0.0, 0.0, 0.0)), dtype=float)
     base = sum(np.array([out[f"f{a}1_{L}"][0] for a in "xyz"]) for L in model.structure.legs)
     assert np.allclose(base, -weight * g - payload, rtol=1e-10, atol=1e-9)
+
+
+@pytest.mark.parametrize("leg", STRUCTURES)
+@pytest.mark.parametrize("backend", ["numpy", "c"])
+def test_payload_efforts_are_the_references_without_gravity(leg: str, backend: str) -> None:
+    """The efforts holding the payload at rest: the reference's at rest with no gravity."""
+    data, model = _model(leg, 23)
+    data = {**data, "payload": {"force": [3.0, -2.0, 5.0], "moment": [0.4, -0.3, 0.2]}}
+    model = rpr3gen.model_from_dict(data)
+    q, _, _ = _motion(data, 23)
+    tau = rpr3gen.payload_efforts(model, q, backend)
+    rest = np.zeros_like(q)
+    weightless = {**data, "environment": {"gravity": [0.0, 0.0, 0.0]}}
+    ref = sr.solve(weightless, q, rest, rest)
+    want = np.column_stack([ref[f"tau_{L}"] for L in model.structure.legs])
+    assert np.allclose(tau, want, rtol=1e-9, atol=1e-9 * np.abs(want).max())
+    assert np.abs(want).max() > 0  # the payload does load the actuators

@@ -407,6 +407,42 @@ def forward_dynamics(structure: SpatialStructure) -> FunctionSpec:
     )
 
 
+def payload_efforts(structure: SpatialStructure) -> FunctionSpec:
+    """``rpr3_payload_efforts``: the efforts holding the payload wrench at rest, no gravity:
+    the inverse dynamics at ``(q, 0, 0)`` with the gravity zeroed (what no inertial parameter
+    scales; ``templates/spatial_payload.c.jinja``)."""
+    params = param_names(structure)
+    context = dict(_c_context(structure))
+    unit = "N m" if structure.actuated_kind == "R" else "N"
+    return FunctionSpec(
+        name="payload_efforts",
+        doc="The actuator efforts holding the model's payload wrench at rest, without gravity: "
+        "the inverse dynamics at (q, 0, 0) with gravity zeroed.",
+        inputs=(pose_arguments(structure)[0],),
+        outputs=(
+            Output(
+                "tau_payload",
+                (sp.Integer(0),) * len(structure.legs),
+                tuple(
+                    Component(f"tau_{leg}", unit, f"payload effort, leg {leg}")
+                    for leg in structure.legs
+                ),
+                "payload efforts",
+            ),
+        ),
+        program=Program(),
+        checks=(Check("inputs_not_finite", "NOT_FINITE"), Check("custom", "SINGULAR")),
+        c_body="spatial_payload.c.jinja",
+        c_context=(
+            ("k", structure.dof),
+            ("outputs", context["outputs"]),
+            ("tau", context["tau"]),
+            ("gravity", [params.index(n) for n in ("gx", "gy", "gz")]),
+            ("params", len(params)),
+        ),
+    )
+
+
 #: The tracked forward kinematics' numbers: Newton steps, halvings of a step, convergence on
 #: the largest residual |qa(q) - qa| (rad or m).
 FK_TUNING: tuple[tuple[str, object], ...] = (("max_iter", 30), ("max_halvings", 30),
@@ -460,6 +496,7 @@ FUNCTIONS: Mapping[str, FunctionBuilder] = {
     "task_space_dynamics": task_space_dynamics,
     "forward_dynamics": forward_dynamics,
     "forward_kinematics": forward_kinematics,
+    "payload_efforts": payload_efforts,
 }
 
 

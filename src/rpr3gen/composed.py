@@ -1,6 +1,6 @@
 """The NumPy versions of the spatial robots' hand-written C functions, composed from the
-generated ones: the efforts, the control form, the forward dynamics and the tracked forward
-kinematics (docs/spatial-robots.md).
+generated ones: the efforts, the payload's efforts, the control form, the forward dynamics and
+the tracked forward kinematics (docs/spatial-robots.md).
 
 The inverse dynamics' efforts are affine in the platform's acceleration, ``tau = T q'' +
 tau0``: ``tau0`` is the inverse dynamics at ``q'' = 0`` and column ``j`` of ``T`` the inverse
@@ -26,6 +26,7 @@ COMPOSED: tuple[str, ...] = (
     "task_space_dynamics",
     "forward_dynamics",
     "forward_kinematics",
+    "payload_efforts",
 )
 
 #: The parameters of the loads that do not come from the motion: gravity and the payload.
@@ -55,6 +56,13 @@ def run(
     q = inputs[0]
     n, k = q.shape
     zero = np.zeros_like(q)
+    if function.name == "payload_efforts":
+        p0 = params.copy()
+        for name in ("gx", "gy", "gz"):
+            p0[variant.param_names.index(name)] = 0.0
+        (out,) = generated("inverse_dynamics", p0, [q, zero, zero])
+        outputs[0][:] = out[:, tau_rows]
+        return
     if function.name == "actuator_efforts":
         (out,) = generated("inverse_dynamics", params, inputs)
         outputs[0][:] = out[:, tau_rows]

@@ -33,7 +33,7 @@ from rpr3gen.control import platform_radius
 from rpr3gen.errors import IdentificationError, InputError, Rpr3genError
 from rpr3gen.model import LEGS, Model
 from rpr3gen.structure import planar_only
-from rpr3gen.validation import Rows, checked
+from rpr3gen.validation import PoseRows, Rows, checked, match_width
 
 __all__ = [
     "INERTIAL_PARAMETER_NAMES",
@@ -225,11 +225,12 @@ def regressor(
     return Y @ shared_matrix() if identical_legs else Y
 
 
-@checked(q=Rows(3))
+@checked(q=PoseRows())
 def payload_efforts(model: Model, q: ArrayLike, backend: str = "numpy") -> np.ndarray:
     """``tau_payload`` (n, 3): the efforts holding the model's payload wrench at rest (generated,
-    eqs. 12-17 with only the payload acting), which no inertial parameter scales."""
-    planar_only(model.structure, "payload_efforts")
+    eqs. 12-17 with only the payload acting), which no inertial parameter scales; a spatial
+    robot's (n, 6) or (n, 3), from its inverse dynamics at rest without gravity."""
+    match_width(model.structure.dof, model.structure.title, q=np.asarray(q))
     (tau,), _ = evaluate(model, "payload_efforts", (q,), backend)
     return tau
 
