@@ -17,7 +17,6 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import sympy as sp
-from rpr3gen_derive.codegen.functions import wrap_angle
 from rpr3gen_derive.spatial.bodies import Wrench, body_wrench, u_joint
 from rpr3gen_derive.spatial.platform import PlatformMotion, param
 from rpr3gen_derive.spatial.structures import INERTIA_ENTRIES
@@ -312,4 +311,4 @@ def leg(prog_namer: Namer, kinds: str, leg_: str, pm: PlatformMotion) -> Leg:
     return delta(prog_namer, leg_, pm, kinds[0])
 
 
-__all__ = ["Connector", "JointLoad", "Leg", "leg", "wrap_angle"]
+__all__ = ["Connector", "JointLoad", "Leg", "leg"]

@@ -73,11 +73,6 @@ class SpatialStructure:
         return f"{len(self.legs)}-{self.kinds}, motors on joint {self.actuated}"
 
 
-def from_variant(variant: str) -> SpatialStructure:
-    kinds, _, joint = variant.partition("_")
-    return SpatialStructure(kinds.upper(), int(joint))
-
-
 ALL: tuple[SpatialStructure, ...] = tuple(SpatialStructure(k, v[1]) for k, v in LEG_TYPES.items())
 
 

@@ -32,6 +32,7 @@ import numpy as np
 from rpr3gen.atomic import atomic_write
 from rpr3gen.errors import ModelError
 from rpr3gen.model import Model
+from rpr3gen.spatial_modes import point
 from rpr3gen.structure import INERTIA_ENTRIES
 
 __all__ = ["SOLIMP", "SOLREF", "TIMESTEP", "mjcf", "write_mjcf"]
@@ -51,10 +52,6 @@ def _num(x: float) -> str:
 
 def _vec(v: Sequence[float] | np.ndarray) -> str:
     return " ".join(_num(x) for x in v)
-
-
-def _p(model: Model, name: str, leg: str) -> np.ndarray:
-    return np.array([model.params[f"{name}{a}_{leg}"] for a in "xyz"])
 
 
 def _inertia(model: Model, k: int | str, leg: str | None) -> str:
@@ -119,7 +116,7 @@ def _u(model: Model, leg: str, centre: np.ndarray, indent: str, name: str) -> li
     at = _vec(centre)
     return [
         f'{indent}<joint name="{name}{k}_{leg}" type="hinge" pos="{at}" axis="{_vec(axis)}"/>'
-        for k, axis in (("a", _p(model, "u1", leg)), ("b", _p(model, "u2", leg)))
+        for k, axis in (("a", point(model, "u1", leg)), ("b", point(model, "u2", leg)))
     ]
 
 
@@ -131,8 +128,8 @@ def _connect(name: str, body: str, anchor: np.ndarray) -> str:
 def _leg(model: Model, leg: str, equalities: list[str]) -> list[str]:
     s = model.structure
     p = model.params
-    B, P = _p(model, "b", leg), _p(model, "p", leg)
-    c1 = _p(model, "c1", leg)
+    B, P = point(model, "b", leg), point(model, "p", leg)
+    c1 = point(model, "c1", leg)
     out: list[str] = []
     if s.leg == "UPS":
         u = (P - B) / np.linalg.norm(P - B)
@@ -140,14 +137,14 @@ def _leg(model: Model, leg: str, equalities: list[str]) -> list[str]:
         out.append("      " + _inertial(p[f"m1_{leg}"], c1, _inertia(model, 1, leg)))
         out += [f'      <body name="piston_{leg}">',
                 f'        <joint name="q2_{leg}" type="slide" pos="{_vec(B)}" axis="{_vec(u)}"/>',
-                "        " + _inertial(p[f"m2_{leg}"], _p(model, "c2", leg),
+                "        " + _inertial(p[f"m2_{leg}"], point(model, "c2", leg),
                                        _inertia(model, 2, leg)),
                 f'        <geom type="sphere" pos="{_vec(P)}"/>',
                 "      </body>", "    </body>"]  # fmt: skip
         equalities.append(_connect(f"S_{leg}", f"piston_{leg}", P))
         return out
-    a = _p(model, "a", leg)
-    E = _p(model, "e", leg)
+    a = point(model, "a", leg)
+    E = point(model, "e", leg)
     kind = "hinge" if s.leg[0] == "R" else "slide"
     first = "crank" if s.leg == "RUS" else "carriage" if s.leg[0] == "P" else "arm"
     out += [f'    <body name="{first}_{leg}">',
@@ -155,12 +152,12 @@ def _leg(model: Model, leg: str, equalities: list[str]) -> list[str]:
             "      " + _inertial(p[f"m1_{leg}"], c1, _inertia(model, 1, leg))]  # fmt: skip
     if s.leg in ("RUS", "PUS"):
         out += [f'      <body name="rod_{leg}">', *_u(model, leg, E, "        ", "q2")]
-        out.append("        " + _inertial(p[f"m2_{leg}"], _p(model, "c2", leg),
+        out.append("        " + _inertial(p[f"m2_{leg}"], point(model, "c2", leg),
                                           _inertia(model, 2, leg)))  # fmt: skip
         out += [f'        <geom type="sphere" pos="{_vec(P)}"/>', "      </body>", "    </body>"]
         equalities.append(_connect(f"S_{leg}", f"rod_{leg}", P))
         return out
-    bar = a if s.leg == "RSS2" else _p(model, "bar", leg)
+    bar = a if s.leg == "RSS2" else point(model, "bar", leg)
     half = p[f"w_{leg}"] / 2
     length = float(np.linalg.norm(P - E))
     u = (P - E) / length

@@ -30,26 +30,30 @@ SAME_MODE = 1e-7
 MODE_TOL = 1e-9
 
 
-def _vector(model: Model, name: str, leg: str) -> np.ndarray:
-    p = model.params
-    return np.array([p[f"{name}{a}_{leg}"] for a in "xyz"])
+def point(model: Model, name: str, leg: str) -> np.ndarray:
+    """A spatial model's home point or axis ``name`` of ``leg`` (``"b"``, ``"e"``, ``"p"``,
+    ``"a"``, ``"bar"``, ``"u1"`` ...), (3,)."""
+    return model.vector([f"{name}{a}_{leg}" for a in "xyz"])
 
 
-def _elbow(model: Model, leg: str, q1: float) -> np.ndarray:
-    B, a, E = (_vector(model, n, leg) for n in ("b", "a", "e"))
+def elbow(model: Model, leg: str, q1: np.ndarray) -> np.ndarray:
+    """The elbow of ``leg`` (RUS, PUS, RSS2, PSS2) at joint 1's coordinates ``q1``, (n, 3):
+    turned about the R axis through ``base``, or slid along the P axis."""
+    B, a, E = (point(model, n, leg) for n in ("b", "a", "e"))
+    q1 = np.atleast_1d(np.asarray(q1, dtype=float))
     if model.structure.actuated_kind == "P":
-        return E + q1 * a
+        return E + np.outer(q1, a)
     c0 = B + (a @ (E - B)) * a
     r0 = E - c0
-    return c0 + math.cos(q1) * r0 + math.sin(q1) * np.cross(a, r0)
+    return c0 + np.outer(np.cos(q1), r0) + np.outer(np.sin(q1), np.cross(a, r0))
 
 
 def delta_candidates(model: Model, qa: np.ndarray) -> np.ndarray:
     """The (at most two) origins on the three spheres of the locked legs, (k, 3)."""
     centres, radii = [], []
     for leg, q1 in zip(model.structure.legs, qa, strict=True):
-        p, e = _vector(model, "p", leg), _vector(model, "e", leg)
-        centres.append(_elbow(model, leg, float(q1)) - p)
+        p, e = point(model, "p", leg), point(model, "e", leg)
+        centres.append(elbow(model, leg, q1)[0] - p)
         radii.append(float(np.linalg.norm(p - e)))
     c1, c2, c3 = centres
     d = float(np.linalg.norm(c2 - c1))
@@ -77,7 +81,7 @@ def delta_candidates(model: Model, qa: np.ndarray) -> np.ndarray:
 def _starts(model: Model) -> np.ndarray:
     """Home and :data:`SEARCH_STARTS` deterministic poses around it (a fixed seed)."""
     size = math.sqrt(
-        sum(float(_vector(model, "p", leg) @ _vector(model, "p", leg))
+        sum(float(point(model, "p", leg) @ point(model, "p", leg))
             for leg in model.structure.legs) / len(model.structure.legs)
     )  # fmt: skip
     rng = np.random.default_rng(20261128)

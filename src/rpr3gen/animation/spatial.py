@@ -13,13 +13,10 @@ from typing import Any
 import numpy as np
 
 from rpr3gen.model import Model
+from rpr3gen.spatial_modes import elbow, point
 from rpr3gen.trajectory import Trajectory
 
 LEG_COLOURS = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown")
-
-
-def _vector(model: Model, name: str, leg: str) -> np.ndarray:
-    return np.array([model.params[f"{name}{a}_{leg}"] for a in "xyz"])
 
 
 def _rotation(q: np.ndarray) -> np.ndarray:
@@ -44,26 +41,20 @@ def leg_polylines(model: Model, q: np.ndarray, out: dict[str, np.ndarray]) -> li
     origin = q[:, :3]
     lines: list[np.ndarray] = []
     for leg in s.legs:
-        p = _vector(model, "p", leg)
+        p = point(model, "p", leg)
         S = origin + R @ p
-        B = _vector(model, "b", leg)
+        B = point(model, "b", leg)
         if s.leg == "UPS":
             lines.append(np.stack([np.broadcast_to(B, S.shape), S], axis=1))
             continue
-        a, e = _vector(model, "a", leg), _vector(model, "e", leg)
+        a = point(model, "a", leg)
         q1 = out[f"q1_{leg}"]
-        if s.actuated_kind == "R":
-            c0 = B + (a @ (e - B)) * a
-            r0 = e - c0
-            E = c0 + np.outer(np.cos(q1), r0) + np.outer(np.sin(q1), np.cross(a, r0))
-            start = np.broadcast_to(B, E.shape)
-        else:
-            E = e + np.outer(q1, a)
-            start = B + np.outer(q1, a)
+        E = elbow(model, leg, q1)
+        start = np.broadcast_to(B, E.shape) if s.actuated_kind == "R" else B + np.outer(q1, a)
         if not s.leg.endswith("SS2"):
             lines.append(np.stack([start, E, S], axis=1))
             continue
-        bar = a if s.leg == "RSS2" else _vector(model, "bar", leg)
+        bar = a if s.leg == "RSS2" else point(model, "bar", leg)
         half = model.params[f"w_{leg}"] / 2 * bar
         arm = np.stack([start, E], axis=1)
         rods = [np.stack([E + k * half, S + k * half], axis=1) for k in (1.0, -1.0)]

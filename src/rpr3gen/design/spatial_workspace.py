@@ -21,6 +21,7 @@ from rpr3gen.backends import evaluate, inverse_dynamics
 from rpr3gen.errors import InputError
 from rpr3gen.model import Model
 from rpr3gen.policy import DEFAULT_MIN_CONDITIONING
+from rpr3gen.spatial_modes import point
 from rpr3gen.validation import Instance, Integer, Number, checked
 
 __all__ = ["SpatialWorkspace", "spatial_workspace", "write_spatial_workspace"]
@@ -59,14 +60,11 @@ class SpatialWorkspace:
 
 def _size(model: Model) -> float:
     """The longest leg at home (base or elbow to the platform point): the box's half size."""
-    p = model.params
-    longest = 0.0
-    for leg in model.structure.legs:
-        target = np.array([p[f"p{a}_{leg}"] for a in "xyz"])
-        start = "b" if model.structure.leg == "UPS" else "e"
-        origin = np.array([p[f"{start}{a}_{leg}"] for a in "xyz"])
-        longest = max(longest, float(np.linalg.norm(target - origin)))
-    return longest
+    start = "b" if model.structure.leg == "UPS" else "e"
+    return max(
+        float(np.linalg.norm(point(model, "p", leg) - point(model, start, leg)))
+        for leg in model.structure.legs
+    )
 
 
 @checked(
