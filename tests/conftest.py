@@ -1,5 +1,5 @@
 """Shared fixtures and session set-up: paths of the source tree, one cache of derived variants
-and C builds per session, the long tests first.
+and C builds per session, the long tests first, a real Dask cluster for the sweeps.
 
 The suite runs on every core (``-n auto --dist worksteal``, pytest-xdist, in
 ``pyproject.toml``). Its workers
@@ -14,7 +14,11 @@ from __future__ import annotations
 
 import os
 import shutil
+import socket
+import subprocess
+import sys
 import tempfile
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -60,3 +64,59 @@ def quick_c_builds(monkeypatch: pytest.MonkeyPatch) -> None:
     flags = tuple("-O0" if f == "-O3" else f for f in cbackend.CFLAGS)
     assert flags != cbackend.CFLAGS
     monkeypatch.setattr(cbackend, "CFLAGS", flags)
+
+
+# -- a Dask cluster ------------------------------------------------------------------------------
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return int(s.getsockname()[1])
+
+
+@pytest.fixture(scope="session")
+def stopping() -> Iterator[list[subprocess.Popen[bytes]]]:
+    """Processes told to stop, waited for at the end of the session: a ``dask worker`` takes
+    seconds to exit after its nanny has closed it, time the other tests can use meanwhile."""
+    procs: list[subprocess.Popen[bytes]] = []
+    yield procs
+    for proc in procs:
+        try:
+            proc.wait(timeout=60)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.wait()
+
+
+@pytest.fixture(scope="session")
+def scheduler(
+    tmp_path_factory: pytest.TempPathFactory, stopping: list[subprocess.Popen[bytes]]
+) -> Iterator[str]:
+    """A ``dask scheduler`` and two ``dask worker`` processes on localhost, for the session's
+    sweep tests (``tests/test_design_sweep.py``, ``tests/test_spatial_sweep.py``); their
+    address. The test waits for them by asking the scheduler, never by sleeping."""
+    from distributed import Client
+
+    logs = tmp_path_factory.mktemp("dask")
+    address = f"tcp://127.0.0.1:{_free_port()}"
+    dask = [sys.executable, "-m", "dask"]
+    commands = [
+        [*dask, "scheduler", "--host", "127.0.0.1", "--port", address.rsplit(":", 1)[1],
+         "--no-dashboard", "--dashboard-address", "127.0.0.1:0"],
+        *([*dask, "worker", address, "--nworkers", "1", "--nthreads", "1", "--no-dashboard",
+           "--name", f"worker-{k}", "--local-directory", str(logs)] for k in range(2)),
+    ]  # fmt: skip
+    procs = []
+    try:
+        for k, command in enumerate(commands):
+            with (logs / f"process-{k}.log").open("wb") as log:
+                procs.append(subprocess.Popen(command, stdout=log, stderr=subprocess.STDOUT))
+        with Client(address, timeout="120s") as client:
+            client.wait_for_workers(2, timeout=120)
+            assert len(client.scheduler_info()["workers"]) == 2
+        yield address
+    finally:
+        for proc in reversed(procs):
+            proc.terminate()
+        stopping.extend(reversed(procs))

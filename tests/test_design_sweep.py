@@ -2,7 +2,8 @@
 process, byte-identical whatever the workers, and resumed without losing anything.
 
 The cluster is real: a ``dask scheduler`` and two ``dask worker`` processes on localhost, on
-free ports, started and stopped here; the test waits for them by asking the scheduler
+free ports, started and stopped by the ``scheduler`` fixture (``tests/conftest.py``, shared with
+``tests/test_spatial_sweep.py``); it waits for them by asking the scheduler
 (``Client.wait_for_workers``), never by sleeping.
 """
 
@@ -10,10 +11,8 @@ from __future__ import annotations
 
 import os
 import pty
-import socket
 import subprocess
 import sys
-from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -145,57 +144,6 @@ def test_an_invalid_combination_is_an_infeasible_row() -> None:
 
 
 # -- the cluster ---------------------------------------------------------------------------------
-
-
-def _free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return int(s.getsockname()[1])
-
-
-@pytest.fixture(scope="session")
-def stopping() -> Iterator[list[subprocess.Popen[bytes]]]:
-    """Processes told to stop, waited for at the end of the session: a ``dask worker`` takes
-    seconds to exit after its nanny has closed it, time the other tests can use meanwhile."""
-    procs: list[subprocess.Popen[bytes]] = []
-    yield procs
-    for proc in procs:
-        try:
-            proc.wait(timeout=60)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-            proc.wait()
-
-
-@pytest.fixture(scope="module")
-def scheduler(
-    tmp_path_factory: pytest.TempPathFactory, stopping: list[subprocess.Popen[bytes]]
-) -> Iterator[str]:
-    """A ``dask scheduler`` and two ``dask worker`` processes on localhost; their address."""
-    from distributed import Client
-
-    logs = tmp_path_factory.mktemp("dask")
-    address = f"tcp://127.0.0.1:{_free_port()}"
-    dask = [sys.executable, "-m", "dask"]
-    commands = [
-        [*dask, "scheduler", "--host", "127.0.0.1", "--port", address.rsplit(":", 1)[1],
-         "--no-dashboard", "--dashboard-address", "127.0.0.1:0"],
-        *([*dask, "worker", address, "--nworkers", "1", "--nthreads", "1", "--no-dashboard",
-           "--name", f"worker-{k}", "--local-directory", str(logs)] for k in range(2)),
-    ]  # fmt: skip
-    procs = []
-    try:
-        for k, command in enumerate(commands):
-            with (logs / f"process-{k}.log").open("wb") as log:
-                procs.append(subprocess.Popen(command, stdout=log, stderr=subprocess.STDOUT))
-        with Client(address, timeout="120s") as client:
-            client.wait_for_workers(2, timeout=120)
-            assert len(client.scheduler_info()["workers"]) == 2
-        yield address
-    finally:
-        for proc in reversed(procs):
-            proc.terminate()
-        stopping.extend(reversed(procs))
 
 
 @pytest.mark.slow

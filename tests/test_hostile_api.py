@@ -22,6 +22,7 @@ from __future__ import annotations
 import dataclasses
 import functools
 import math
+import numbers
 import os
 import re
 import shutil
@@ -35,6 +36,7 @@ import numpy as np
 import pytest
 from hostile_kinds import (
     HUGE,
+    WRONG_ARRAYS,
     Api,
     Kind,
     Where,
@@ -523,6 +525,106 @@ NAME = Kind(
     value_error=TrajectoryError,
 )
 
+# -- retime's arguments: a path (waypoints or a path file) and the actuators' limits ---------
+
+#: An effort limit (N m or N) above every scene's load at rest along its path, and low enough
+#: for TOPP-RA to resolve the motion it allows.
+EFFORT = 200.0
+
+
+def _retime_path(s: Scene) -> np.ndarray:
+    """A path the scene's robot follows: a short turn of the paper's, nine poses of the loop
+    (the loop is closed: its first and last poses are equal, not consecutive)."""
+    if s.paper:
+        return np.array([[0.0, 0.0, 0.0], [0.01, -0.01, 0.1], [0.02, 0.0, 0.2]])
+    return np.ascontiguousarray(_loop().q[::50])
+
+
+def _waypoints(s: Scene) -> Kind:
+    """retime's ``path``: (m, 3) waypoints, m >= 2, finite, no two consecutive equal, or a path
+    file (unknown to the oracle: what it holds decides); other waypoints may leave the
+    workspace (a documented refusal)."""
+    good = _retime_path(s)
+
+    def classify(value: Any) -> str | None:
+        if isinstance(value, str | os.PathLike):
+            return None
+        verdict, array = numeric_array(value)
+        if array is None:
+            return verdict
+        if array.ndim != 2 or array.shape[1] != 3 or len(array) < 2:
+            return "value"
+        if not np.isfinite(array).all() or (np.diff(array, axis=0) == 0).all(axis=1).any():
+            return "value"
+        return "ok" if np.array_equal(array, good) else None
+
+    return Kind(
+        "waypoints",
+        classify,
+        wrong_types=tuple(v for v in WRONG_ARRAYS if not isinstance(v, str)),
+        bad_values=(
+            good[:1],
+            np.zeros((2, 3)),
+            np.zeros((3, 2)),
+            np.zeros(3),
+            np.float64(0.0),
+            [[0.0, 0.0, 0.0], [math.nan, 0.0, 0.0]],
+            [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]],  # out of reach
+            Where("missing", lambda tmp: str(tmp / "missing.csv")),
+        ),
+        good_values=(good, good.tolist()),
+        value_error=(InputError, TrajectoryError),
+    )
+
+
+def _limit_verdict(value: Any) -> str | None:
+    """A limit: a number > 0, or one (finite, > 0) per actuator, (1,) or (3,); a positive
+    limit may still be refused (too low to hold the robot, too high to resolve)."""
+    if isinstance(value, bool | np.bool_):
+        return "type"
+    if isinstance(value, numbers.Real):
+        try:
+            x = float(value)
+        except OverflowError:
+            return "value"
+        return "ok" if math.isfinite(x) and x > 0 else "value"
+    verdict, array = numeric_array(value)
+    if array is None:
+        return verdict
+    if array.shape not in ((), (1,), (3,)):
+        return "value"
+    return "ok" if (np.isfinite(array) & (array > 0)).all() else "value"
+
+
+def _limit_kind(good: tuple[Any, ...]) -> Kind:
+    return Kind(
+        "limit",
+        _limit_verdict,
+        wrong_types=("10", None, True, [["a"]], {"x": 1.0}, 1j, object()),
+        bad_values=(
+            0.0,
+            -1.0,
+            math.nan,
+            math.inf,
+            10**400,
+            [1.0, 2.0],
+            [10.0, 0.0, 10.0],
+            np.ones((1, 3)),
+            [],
+        ),
+        good_values=good,
+    )
+
+
+EFFORT_LIMIT = dataclasses.replace(
+    _limit_kind((EFFORT, [EFFORT] * 3, np.float64(EFFORT))),
+    bad_values=(*_limit_kind(()).bad_values, 1e-9),  # 1e-9: cannot hold the robot at rest
+)
+#: 1.7e153: a find of the random fuzz (its square overflowed in retime's scaling, a
+#: RuntimeWarning); a rate limit that limits nothing.
+VELOCITY_LIMIT = optional(_limit_kind((1.0, [1.0, 2.0, 3.0], 1.7e153)))
+
+
 # -- the table ------------------------------------------------------------------------------
 
 MOTION3 = (("q", "qd", "qdd"),)
@@ -713,6 +815,11 @@ def apis(s: Scene) -> tuple[Api, ...]:
             "inertial_parameters",
             good=lambda tmp: {"model": model},
             kinds={"model": model_kind, "identical_legs": identical_legs},
+        ),
+        _api(
+            "inertial_parameter_names",
+            good=lambda tmp: {"model": model},
+            kinds={"model": model_kind, "identical_legs": flag()},
         ),
         _api(
             "identify",
@@ -920,6 +1027,27 @@ def apis(s: Scene) -> tuple[Api, ...]:
             scene_free=True,
         ),
         _api(
+            "retime",
+            good=lambda tmp: {
+                "model": model,
+                "path": _retime_path(s),
+                "effort_limit": EFFORT,
+                "samples": 5,
+                "grid_points": 21,
+                **on,
+            },
+            kinds={
+                "model": model_kind,
+                "path": _waypoints(s),
+                "effort_limit": EFFORT_LIMIT,
+                "velocity_limit": VELOCITY_LIMIT,
+                "samples": count(2, 20),
+                "grid_points": count(3, 40),
+                "min_conditioning": number(least=0.0, below=1.0, good=(0.0, 1e-3)),
+                "backend": backend,
+            },
+        ),
+        _api(
             "Fit.predict",
             call=lambda q, qd, qdd: s.fit.predict(q, qd, qdd),
             good=lambda tmp: {"q": q, "qd": qd, "qdd": qdd},
@@ -946,6 +1074,7 @@ REFUSALS: dict[str, tuple[type[Exception], ...]] = {
     "SampleEvaluator.evaluate": (Rpr3genError,),
     "Trajectory.from_positions": (TrajectoryError,),
     "Trajectory": (TrajectoryError,),
+    "retime": (InputError, TrajectoryError),
 }
 
 EXEMPT = {
@@ -1224,7 +1353,8 @@ def test_identical_legs_is_refused_where_the_legs_differ(where: str, tmp_path: P
     that is not this one."""
     checked = []
     for api in table(where).values():
-        if "identical_legs" in api.kinds:
+        # The names alone are those of the shared parameters whatever the legs' values.
+        if "identical_legs" in api.kinds and api.name != "inertial_parameter_names":
             with pytest.raises(InputError, match=r"^identical_legs: leg B's .* differ"):
                 _call(api, tmp_path, identical_legs=True)
             checked.append(api.name)

@@ -31,6 +31,8 @@ from rpr3gen.parameters import inertial_parameters
 
 ROOT = Path(__file__).resolve().parent.parent
 DELTA = str(ROOT / "models" / "delta.toml")
+RRR = str(ROOT / "models" / "rrr.toml")
+LOOP_PATH = str(ROOT / "models" / "loop-path.csv")
 
 # -- the options' values ------------------------------------------------------------------
 
@@ -185,6 +187,8 @@ COMMANDS: tuple[Command, ...] = (
             "--min-conditioning": CONDITIONING,
             "--seed": Numeric(whole=True, least=0),
             "--max-iterations": Numeric(whole=True, least=1, most=2**31 - 1),
+            "--max-translation": Numeric(least=0.0),
+            "--max-angle": Numeric(least=0.0),
         },
         outputs={"--out": False},
         inputs={"--model": "model"},
@@ -200,6 +204,33 @@ COMMANDS: tuple[Command, ...] = (
         },
         outputs={"--out": True},
         inputs={"--model": "model"},
+    ),
+    Command(
+        "retime",
+        lambda tmp: [
+            "retime",
+            "--model",
+            RRR,
+            "--path",
+            LOOP_PATH,
+            "--effort-limit",
+            "8",
+            "--out",
+            str(tmp / "fast.csv"),
+            "--grid-points",
+            "41",
+            "--samples",
+            "11",
+        ],
+        numbers={
+            "--effort-limit": Numeric(least=0.0),  # > 0: no case tries 0 itself
+            "--velocity-limit": Numeric(least=0.0),
+            "--samples": Numeric(whole=True, least=2, size=True),
+            "--grid-points": Numeric(whole=True, least=3, size=True),
+            "--min-conditioning": CONDITIONING,
+        },
+        outputs={"--out": False},
+        inputs={"--model": "model", "--path": "path", "--generated": "generated"},
     ),
     Command(
         "export",
@@ -224,6 +255,7 @@ COMMANDS: tuple[Command, ...] = (
             "--workers": Numeric(whole=True, least=0, size=True),
             "--chunk-size": Numeric(whole=True, least=1),
             "--area-resolution": Numeric(whole=True, least=0, size=True),
+            "--volume-resolution": Numeric(whole=True, least=0, size=True),
             "--min-conditioning": CONDITIONING,
         },
         outputs={"--out": False},
@@ -447,6 +479,18 @@ def _inputs(kind: str) -> list[tuple[str, Callable[[Path], str], str]]:
         ]
     if kind == "data":
         cases.append(("one row", lambda tmp: data_csv(tmp, slice(0, 1)), "more samples"))
+    if kind == "path":  # waypoints of the 3-RRR: x,y,phi, no times
+        cases += [
+            ("a NaN", written("nan.csv", "x,y,phi\n0,0,0\n0,0,nan\n"), "not finite"),
+            ("one waypoint", written("one.csv", "x,y,phi\n0,0,0\n"), "at least 2 waypoints"),
+            ("no phi", written("xy.csv", "x,y\n0,0\n0.01,0\n"), "missing column 'phi'"),
+            ("a repeat", written("rep.csv", "x,y,phi\n0,0,0\n0,0,0\n"), "line 3 (waypoint 2)"),
+            (
+                "a singular pose",  # the 3-RRR's parallel singularity at (0, 0, 0.51813)
+                written("sing.csv", "x,y,phi\n0,0,0\n0,0,0.51813\n"),
+                "sing.csv: line 3 (waypoint 2)",
+            ),
+        ]
     return cases
 
 

@@ -326,10 +326,25 @@ CASES: dict[str, tuple[dict, str, tuple[str, ...]]] = {
         ("UPS legs carry their motor on joint 2", "got 1"),
     ),
     "actuated a boolean": (_edit("delta", actuated=True), "actuated", ("joint 1", "got true")),
-    "limits": (
-        _edit("delta", limits={"q1": [-1.0, 1.0]}),
-        "limits",
-        ("not supported for spatial models yet",),
+    "limit of a joint without a coordinate": (
+        _edit("delta", limits={"q2": [-1.0, 1.0]}),
+        "limits.q2",
+        ("unknown key", "'q1'"),
+    ),
+    "limit of a hexapod's S joint": (
+        _edit("tsai-ups", limits={"q3": [-1.0, 1.0]}),
+        "limits.q3",
+        ("unknown key", "'q1a', 'q1b', 'q2'"),
+    ),
+    "limit upside down": (
+        _edit("tsai-ups", limits={"q2": [0.1, -0.1]}),
+        "limits.q2",
+        ("lower bound must be below the upper",),
+    ),
+    "limit not a pair": (
+        _edit("delta", limits={"q1": [0.1]}),
+        "limits.q1",
+        ("must be a list of 2 numbers",),
     ),
     "wrong type": (
         _edit("tsai-ups", legs__A__base="origin"),

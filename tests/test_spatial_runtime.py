@@ -15,7 +15,7 @@ import rpr3gen
 from rpr3gen import control
 from rpr3gen.backends import output_names
 from rpr3gen.cli import main
-from rpr3gen.errors import ModelError, TrajectoryError
+from rpr3gen.errors import TrajectoryError
 
 ROOT = Path(__file__).resolve().parent.parent
 GALLERY = ("tsai-ups", "rus-hexapod", "pus-hexapod", "delta", "linear-delta")
@@ -170,26 +170,6 @@ def test_generate_refuses_a_wrong_actuated_joint(capsys: pytest.CaptureFixture) 
     assert "joint 2" in capsys.readouterr().err
 
 
-@pytest.mark.parametrize(
-    "command",
-    [
-        ["identify", "--data", "models/delta.csv"],
-        ["excite", "--out", "e.csv"],
-    ],
-)
-def test_commands_not_yet_spatial_refuse_in_one_line(
-    command: list[str], capsys: pytest.CaptureFixture, tmp_path: Path, monkeypatch
-) -> None:
-    monkeypatch.chdir(ROOT)
-    args = [command[0], "--model", "models/delta.toml", *command[1:]]
-    args = [str(tmp_path / a) if a.endswith((".parquet", ".gif")) or a == "e.csv" else a
-            for a in args]  # fmt: skip
-    assert main(args) != 0
-    err = capsys.readouterr().err.strip()
-    assert len(err.splitlines()) == 1
-    assert "not available for spatial robots yet" in err
-
-
 @pytest.mark.parametrize("name", ["tsai-ups", "delta"])
 def test_animate_draws_a_spatial_robot_in_3d(name: str, tmp_path: Path) -> None:
     from PIL import Image
@@ -216,9 +196,3 @@ def test_params_prints_the_spatial_parameter_vector(capsys: pytest.CaptureFixtur
     model = _model("delta")
     assert [line.split()[0] for line in lines] == list(model.param_names)
     assert [float(line.split()[1]) for line in lines] == list(model.vector())
-
-
-def test_the_python_api_refuses_what_is_not_spatial_yet() -> None:
-    model = _model("delta")
-    with pytest.raises(ModelError, match="spatial"):
-        rpr3gen.inertial_parameters(model)

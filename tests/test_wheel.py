@@ -24,8 +24,9 @@ _NOT_SOURCES = shutil.ignore_patterns(
 #: by `rpr3gen generate`, which names the `derive` extra when it is missing).
 OWN = {"rpr3gen", "rpr3gen_generated", "rpr3gen_derive"}
 #: The extras whose modules the runtime may import, each only where an ImportError is caught
-#: (``video``: imageio-ffmpeg's ffmpeg for MP4 movies, rpr3gen.animation).
-RUNTIME_EXTRAS = ("video",)
+#: (``video``: imageio-ffmpeg's ffmpeg for MP4 movies, rpr3gen.animation; ``toppra``: TOPP-RA for
+#: rpr3gen.retime, rpr3gen.retiming.topp).
+RUNTIME_EXTRAS = ("video", "toppra")
 
 #: Run in the fresh venv: every requirement the installed wheel declares is met, by version.
 _REQUIREMENTS_MET = """

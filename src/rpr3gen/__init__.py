@@ -49,10 +49,12 @@ from rpr3gen.parameters import (
     INERTIAL_PARAMETER_NAMES,
     base_parameters,
     base_regressor,
+    inertial_parameter_names,
     inertial_parameters,
     payload_efforts,
     regressor,
 )
+from rpr3gen.retiming import retime
 from rpr3gen.sample import SampleEvaluator
 from rpr3gen.trajectory import Trajectory, paper_trajectory, read_trajectory_csv
 from rpr3gen.version import __version__
@@ -90,6 +92,7 @@ __all__ = [
     "forward_dynamics",
     "forward_kinematics",
     "identify",
+    "inertial_parameter_names",
     "inertial_parameters",
     "inverse_dynamics",
     "jacobian_rate",
@@ -101,6 +104,7 @@ __all__ = [
     "platform_velocity",
     "read_trajectory_csv",
     "regressor",
+    "retime",
     "sweep",
     "task_space_dynamics",
     "workspace",

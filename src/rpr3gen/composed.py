@@ -16,6 +16,7 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
+from rpr3gen import spatial_inertia
 from rpr3gen.manifest import FunctionInfo, Variant
 
 #: ``run(function name, params, inputs) -> outputs (n, size) each``: the generated NumPy code.
@@ -27,6 +28,7 @@ COMPOSED: tuple[str, ...] = (
     "forward_dynamics",
     "forward_kinematics",
     "payload_efforts",
+    "regressor",
 )
 
 #: The parameters of the loads that do not come from the motion: gravity and the payload.
@@ -63,6 +65,9 @@ def run(
         (out,) = generated("inverse_dynamics", p0, [q, zero, zero])
         outputs[0][:] = out[:, tau_rows]
         return
+    if function.name == "regressor":
+        outputs[0][:] = _regressor(variant, params, inputs, generated, tau_rows)
+        return
     if function.name == "actuator_efforts":
         (out,) = generated("inverse_dynamics", params, inputs)
         outputs[0][:] = out[:, tau_rows]
@@ -92,6 +97,31 @@ def _tau_rows(variant: Variant) -> list[int]:
     names = variant.function("inverse_dynamics").outputs[0].names
     legs = [n.rpartition("_")[2] for n in names if n.startswith("tau_")]
     return [names.index(f"tau_{leg}") for leg in legs]
+
+
+def _regressor(
+    variant: Variant,
+    params: np.ndarray,
+    inputs: Sequence[np.ndarray],
+    generated: Runner,
+    rows: list[int],
+) -> np.ndarray:
+    """``Y`` (n, k * P, row-major): column ``j`` is the inverse dynamics' efforts for the model
+    numbers whose ``pi`` is ``e_j`` (:func:`rpr3gen.spatial_inertia.unit_columns`)."""
+    kinds = variant.defines["LEG"].strip('"')
+    legs = "ABCDEF"[: int(variant.defines["NUM_LEGS"])]
+    columns = []
+    mass_column = np.zeros((len(inputs[0]), len(rows)))
+    for p, role in spatial_inertia.unit_columns(kinds, legs, variant.param_names, params):
+        (out,) = generated("inverse_dynamics", p, inputs)
+        tau = out[:, rows]
+        if role == "moment":
+            tau = tau - mass_column
+        elif role == "mass":
+            mass_column = tau
+        columns.append(tau)
+    Y = np.stack(columns, axis=2)  # (n, k, P)
+    return Y.reshape(len(Y), -1)
 
 
 def _efforts_matrix(

@@ -21,7 +21,6 @@ from rpr3gen.errors import IdentificationError, IdentificationWarning, InputErro
 from rpr3gen.identifiability import MAX_CONDITION, WARN_CONDITION, Assessment, assess, combinations
 from rpr3gen.model import LEGS, Model
 from rpr3gen.parameters import (
-    SHARED_PARAMETER_NAMES,
     BaseParameters,
     base_parameters,
     one_blas_thread,
@@ -29,8 +28,7 @@ from rpr3gen.parameters import (
     regressor_and_codes,
     shared_matrix,
 )
-from rpr3gen.structure import planar_only
-from rpr3gen.validation import Number, Optional, Reading, Rows, Sample, checked
+from rpr3gen.validation import Number, Optional, PoseRows, Reading, Sample, checked, match_width
 
 MAX_WEIGHT_RATIO = 1e6
 """The largest ratio of two actuators' weights :func:`identify` takes: beyond it the least
@@ -50,25 +48,26 @@ __all__ = [
 ]
 
 
-def friction_names() -> tuple[str, ...]:
-    """Friction parameters per actuator: viscous ``fv_A..C`` then Coulomb ``fc_A..C``."""
-    return tuple(f"fv_{leg}" for leg in LEGS) + tuple(f"fc_{leg}" for leg in LEGS)
+def friction_names(legs: tuple[str, ...] = LEGS) -> tuple[str, ...]:
+    """Friction parameters per actuator: viscous ``fv_A..`` then Coulomb ``fc_A..``."""
+    return tuple(f"fv_{leg}" for leg in legs) + tuple(f"fc_{leg}" for leg in legs)
 
 
 def friction_columns(
     model: Model, q: np.ndarray, qd: np.ndarray, backend: str = "numpy"
 ) -> np.ndarray:
-    """(n, 3, 6): effort of actuator i += fv_i qa'_i + fc_i sign(qa'_i), ``qa' = J q'``."""
+    """(n, k, 2k): effort of actuator i += fv_i qa'_i + fc_i sign(qa'_i), ``qa' = J q'``."""
     rate = np.einsum("nij,nj->ni", actuator_jacobian(model, q, backend), qd)
     return friction_columns_of_rates(rate)
 
 
 def friction_columns_of_rates(rate: np.ndarray) -> np.ndarray:
-    """:func:`friction_columns` from the actuator rates ``qa'`` (n, 3)."""
-    out = np.zeros((len(rate), 3, 6))
-    for i in range(3):
+    """:func:`friction_columns` from the actuator rates ``qa'`` (n, k)."""
+    k = rate.shape[1]
+    out = np.zeros((len(rate), k, 2 * k))
+    for i in range(k):
         out[:, i, i] = rate[:, i]
-        out[:, i, 3 + i] = np.sign(rate[:, i])
+        out[:, i, k + i] = np.sign(rate[:, i])
     return out
 
 
@@ -78,17 +77,18 @@ class Fit:
 
     Attributes:
         names: the estimated parameters: the base parameters (``base.names``), then with
-            friction ``fv_A..C`` (N m s/rad or N s/m) and ``fc_A..C`` (N m or N).
+            friction ``fv_A..`` (N m s/rad or N s/m) and ``fc_A..`` (N m or N), one per
+            actuator.
         values: (len(names),) the estimates.
         std: (len(names),) their standard deviations (from the weighted residual).
         residual_rms: RMS of ``tau - predicted`` over every sample and actuator (N m or N).
-        residual_rms_per_actuator: (3,) the same per actuator.
+        residual_rms_per_actuator: (k,) the same per actuator.
         condition_number: of the stacked regressor (base and friction columns, unweighted,
             scaled to unit norm): how well the motion excites the parameters.
         inflation: (len(names),) how much the motion inflates each standard deviation: its
             ratio to what it would be with that parameter's column orthogonal to the others
             (the square root of the variance inflation factor; 1 at best).
-        weights: (3,) the weight of each actuator's rows (1 / its residual std).
+        weights: (k,) the weight of each actuator's rows (1 / its residual std).
         samples: the number of samples used.
         base: the base parameters (what ``values[:B]`` stand for).
         model: the model whose geometry the regressor used.
@@ -111,10 +111,12 @@ class Fit:
     identical_legs: bool = False
     backend: str = "numpy"
 
-    @checked(q=Rows(3), qd=Rows(3), qdd=Rows(3), same_length=[("q", "qd", "qdd")])
+    @checked(q=PoseRows(), qd=PoseRows(), qdd=PoseRows(), same_length=[("q", "qd", "qdd")])
     def predict(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> np.ndarray:
-        """The efforts (n, 3) the identified parameters give for a motion (with friction)."""
-        q, qd, qdd = np.asarray(q), np.asarray(qd), np.asarray(qdd)  # (n, 3) each: checked
+        """The efforts (n, k) the identified parameters give for a motion (with friction)."""
+        q, qd, qdd = np.asarray(q), np.asarray(qd), np.asarray(qdd)  # (n, k) each: checked
+        s = self.model.structure
+        match_width(s.dof, s.title, q=q, qd=qd, qdd=qdd)
         columns = _columns(self.model, q, qd, qdd, self.base, self.friction, self.backend)
         return columns @ self.values + payload_efforts(self.model, q, self.backend)
 
@@ -146,9 +148,9 @@ def _design(
     friction: bool,
     backend: str,
 ) -> np.ndarray:
-    """The columns of the fit (n, 3, B [+ 6]) from the per-leg regressor Y (n, 3, 28)."""
-    if base.parameter_names == SHARED_PARAMETER_NAMES:
-        Y = Y @ shared_matrix()
+    """The columns of the fit (n, k, B [+ 2k]) from the per-leg regressor Y (n, k, P)."""
+    if len(base.parameter_names) != Y.shape[2]:  # identical legs
+        Y = Y @ shared_matrix(model)
     Yb = Y[..., list(base.columns)]
     if friction:
         Yb = np.concatenate([Yb, friction_columns(model, q, qd, backend)], axis=2)
@@ -193,11 +195,11 @@ def _inflated(fit: Fit, warn_condition: float, most: int = 5) -> str:
 
 
 @checked(
-    q=Rows(3),
-    qd=Rows(3),
-    qdd=Rows(3),
-    tau=Rows(3),
-    weights=Optional(Reading(3, positive=True)),
+    q=PoseRows(),
+    qd=PoseRows(),
+    qdd=PoseRows(),
+    tau=PoseRows(),
+    weights=Optional(Reading(None, positive=True)),
     warn_condition=Number(finite=False, greater=1.0),
     max_condition=Number(finite=False, greater=1.0),
     t=Optional(Sample()),
@@ -224,19 +226,19 @@ def identify(
     Weighted least squares on ``tau - tau_payload = Yb @ x`` (Gautier's method): an ordinary
     fit first, then each actuator's rows weighted by the inverse of its residual standard
     deviation (unless ``weights`` gives them), and the fit again. Standard deviations:
-    ``sigma^2 (Wᵀ W)^-1`` with ``sigma^2`` the weighted residual's variance (``3n - p``
-    degrees of freedom).
+    ``sigma^2 (Wᵀ W)^-1`` with ``sigma^2`` the weighted residual's variance (``k n - p``
+    degrees of freedom, ``k`` actuators; 3 for planar robots and Deltas, 6 for hexapods).
 
     Args:
         model: the robot whose geometry (and payload) the regressor uses; its masses are not.
-        q: (n, 3) the measured platform poses.
+        q: (n, k) the measured platform poses.
         qd: (n, 3) their velocities, as estimated (e.g. by a smoothing spline:
             :meth:`rpr3gen.Trajectory.from_positions`).
-        qdd: (n, 3) their accelerations, estimated likewise.
-        tau: (n, 3) the measured actuator efforts (``m10_*`` or ``f21z_*``).
+        qdd: (n, k) their accelerations, estimated likewise.
+        tau: (n, k) the measured actuator efforts (``m10_*`` or ``f21z_*``; ``tau_*``).
         friction: also estimate viscous and Coulomb friction per actuator.
-        identical_legs: the legs share one set of parameters (B = 9 instead of 19).
-        weights: (3,) the weight of each actuator's rows instead of the automatic ones
+        identical_legs: the legs share one set of parameters (paper: B = 9 instead of 19).
+        weights: (k,) the weight of each actuator's rows instead of the automatic ones
             (positive; only their ratios count, at most :data:`MAX_WEIGHT_RATIO`).
         warn_condition: above this condition number the fit warns (default
             :data:`WARN_CONDITION`, 1e3; :mod:`rpr3gen.identifiability` says why).
@@ -256,8 +258,15 @@ def identify(
             ``max_condition``): the fit is returned, and the warning names the estimates whose
             standard deviations the motion inflates most.
     """
-    planar_only(model.structure, "identification")
-    q, qd, qdd, tau = (np.asarray(a) for a in (q, qd, qdd, tau))  # (n, 3) each: checked
+    q, qd, qdd, tau = (np.asarray(a) for a in (q, qd, qdd, tau))  # (n, k) each: checked
+    s = model.structure
+    k = s.dof
+    match_width(k, s.title, q=q, qd=qd, qdd=qdd, tau=tau)
+    if weights is not None and np.asarray(weights).shape != (k,):
+        raise InputError(
+            f"weights: must have shape ({k},) for the {s.title}, got {np.asarray(weights).shape}",
+            argument="weights",
+        )
     times = None if t is None else np.asarray(t)  # (n,), finite: checked
     n = q.shape[0]
     sizes.check("q", n, lambda k: k * sizes.IDENTIFY_SAMPLE, "the least-squares problem",
@@ -279,11 +288,11 @@ def identify(
             f"({bad.size} of {n} samples refused)"
         )
     columns = _design(model, Y, q, qd, base, friction, backend)
-    names = base.names + (friction_names() if friction else ())
+    names = base.names + (friction_names(s.legs) if friction else ())
     p = len(names)
-    if 3 * n <= p:
+    if k * n <= p:
         raise IdentificationError(
-            f"{n} samples give {3 * n} equations for {p} unknowns: give more samples"
+            f"{n} samples give {k * n} equations for {p} unknowns: give more samples"
         )
     rhs = tau - payload_efforts(model, q, backend)
 
@@ -298,14 +307,14 @@ def identify(
     if refusal is not None:
         raise IdentificationError(refusal)
     if weights is None:
-        x, _, _ = solve(np.ones(3))
-        r = (rhs - columns @ x).reshape(n, 3)
-        dof = max(n - p / 3, 1.0)
+        x, _, _ = solve(np.ones(k))
+        r = (rhs - columns @ x).reshape(n, k)
+        dof = max(n - p / k, 1.0)
         sigma = np.sqrt((r**2).sum(axis=0) / dof)
         w = np.where(sigma > 0, 1.0 / np.where(sigma > 0, sigma, 1.0), 1.0)
         w = w / w.max()
     else:
-        w = np.asarray(weights)  # (3,), positive and finite: checked
+        w = np.asarray(weights)  # (k,), positive and finite: checked
         w = w / w.max()  # only their ratios count; so none overflows the weighted rows
         if w.min() < 1.0 / MAX_WEIGHT_RATIO:
             raise InputError(
@@ -316,7 +325,7 @@ def identify(
             )
     x, W, y = solve(w)
     weighted = y - W @ x
-    sigma2 = float(weighted @ weighted) / (3 * n - p)
+    sigma2 = float(weighted @ weighted) / (k * n - p)
     R = np.linalg.qr(W, mode="r")
     import scipy.linalg
 

@@ -27,13 +27,12 @@ import numpy as np
 from numpy.typing import ArrayLike
 from threadpoolctl import threadpool_limits
 
-from rpr3gen import variants
+from rpr3gen import spatial_inertia, variants
 from rpr3gen.backends import evaluate
 from rpr3gen.control import platform_radius
 from rpr3gen.errors import IdentificationError, InputError, Rpr3genError
 from rpr3gen.model import LEGS, Model
-from rpr3gen.structure import planar_only
-from rpr3gen.validation import PoseRows, Rows, checked, match_width
+from rpr3gen.validation import PoseRows, checked, match_width
 
 __all__ = [
     "INERTIAL_PARAMETER_NAMES",
@@ -41,6 +40,7 @@ __all__ = [
     "BaseParameters",
     "base_parameters",
     "base_regressor",
+    "inertial_parameter_names",
     "inertial_parameters",
     "one_blas_thread",
     "parameter_names",
@@ -66,8 +66,16 @@ SHARED_PARAMETER_NAMES: tuple[str, ...] = tuple(
 
 #: The order in which base parameters are chosen (the others are regrouped into them): the
 #: platform's first, then per leg the cylinder's first moments and inertia, the piston's first
-#: moments, its inertia and mass, the cylinder's mass last (docs/identification.md).
-def _preference(identical_legs: bool) -> tuple[str, ...]:
+#: moments, its inertia and mass, the cylinder's mass last (docs/identification.md). A spatial
+#: robot's: the platform's, then per leg each body's first moments and inertia, then its
+#: bodies' masses from the platform down (docs/spatial-robots.md).
+def _preference(model: Model, identical_legs: bool) -> tuple[str, ...]:
+    names = inertial_parameter_names(model, identical_legs)
+    if model.structure.spatial:
+        platform = [n for n in names if n.endswith("_3")]
+        bodies = [n for n in names if not n.endswith("_3")]
+        masses = sorted((n for n in bodies if n.startswith("m_")), key=lambda n: n[2] == "1")
+        return tuple(platform + [n for n in bodies if not n.startswith("m_")] + masses)
     legs = ("",) if identical_legs else LEGS
     order = ["m_3", "mcx_3", "mcy_3", "Jzz_3"]
     for leg in legs:
@@ -94,16 +102,37 @@ def one_blas_thread(function: Callable[_P, _R]) -> Callable[_P, _R]:
 
 
 def parameter_names(identical_legs: bool = False) -> tuple[str, ...]:
-    """The P names of ``pi``: 28 per leg, or 12 with ``identical_legs``."""
+    """The P names of a planar robot's ``pi``: 28 per leg, or 12 with ``identical_legs``."""
     return SHARED_PARAMETER_NAMES if identical_legs else INERTIAL_PARAMETER_NAMES
 
 
-def shared_matrix() -> np.ndarray:
-    """``S`` (28 x 12): ``Y_shared = Y @ S`` sums each leg parameter's three columns."""
-    S = np.zeros((len(INERTIAL_PARAMETER_NAMES), len(SHARED_PARAMETER_NAMES)))
-    for i, name in enumerate(INERTIAL_PARAMETER_NAMES):
-        quantity, body = name.split("_")
-        S[i, SHARED_PARAMETER_NAMES.index(f"{quantity}_{body[0]}")] = 1.0
+def _shared(name: str) -> str:
+    """``mcx_1A`` -> ``mcx_1``: the name of a leg parameter shared by the legs."""
+    quantity, body = name.split("_")
+    return f"{quantity}_{body[:-1]}" if len(body) > 1 else name
+
+
+@checked()
+def inertial_parameter_names(model: Model, identical_legs: bool = False) -> tuple[str, ...]:
+    """The P names of ``model``'s ``pi``: a planar robot's :func:`parameter_names`; a spatial
+    robot's per body ``m, mcx, mcy, mcz, Ixx, Iyy, Izz, Ixy, Ixz, Iyz`` (``_1A``, ``_2A``, ...),
+    per rod pair of a Delta's leg ``m, mc, I`` (``_rA``), then the platform's (``_3``); with
+    ``identical_legs`` each leg parameter once, without the leg letter."""
+    s = model.structure
+    if not s.spatial:
+        return parameter_names(identical_legs)
+    names = spatial_inertia.parameter_names(s.leg, "".join(s.legs))
+    return tuple(dict.fromkeys(_shared(n) for n in names)) if identical_legs else names
+
+
+def shared_matrix(model: Model | None = None) -> np.ndarray:
+    """``S`` (P x P_shared; planar 28 x 12): ``Y_shared = Y @ S`` sums each leg parameter's
+    columns over the legs."""
+    full = INERTIAL_PARAMETER_NAMES if model is None else inertial_parameter_names(model)
+    shared = SHARED_PARAMETER_NAMES if model is None else inertial_parameter_names(model, True)
+    S = np.zeros((len(full), len(shared)))
+    for i, name in enumerate(full):
+        S[i, shared.index(_shared(name))] = 1.0
     return S
 
 
@@ -120,12 +149,22 @@ def inertial_parameters(model: Model, identical_legs: bool = False) -> np.ndarra
     needs the three legs' values equal (legs turned by 120 degrees are not: their first moments
     point other ways in the world's axes).
 
+    A spatial robot's (docs/spatial-robots.md): per body ``m``, ``m (c - P)`` and the inertia
+    tensor about ``P`` (its first joint point at home; world axes), per rod pair ``m``,
+    ``m fr L`` and ``Ir + m (fr L)^2``, the platform's about its frame's origin.
+
     Raises:
         InputError: ``identical_legs`` with a general model whose legs' parameters differ.
-        ModelError: a spatial model (docs/spatial-robots.md: not yet).
     """
-    planar_only(model.structure, "inertial parameters")
     p = model.params
+    s = model.structure
+    if s.spatial:
+        pi = spatial_inertia.inertial_parameters(s.leg, "".join(s.legs), p)
+        if identical_legs:
+            _check_identical_legs(model)
+            S = shared_matrix(model)
+            return np.array([pi[np.flatnonzero(S[:, j])[0]] for j in range(S.shape[1])])
+        return pi
 
     def body(m: float, c: float, c_perp: float, j: float) -> list[float]:
         return [m, m * c, m * c_perp, j + m * (c**2 + c_perp**2)]
@@ -169,9 +208,16 @@ def _check_identical_legs(model: Model) -> None:
     """
     if model.structure.paper:
         return
-    per_leg = _general_legs(model)
+    if model.structure.spatial:
+        s = model.structure
+        pi = spatial_inertia.inertial_parameters(s.leg, "".join(s.legs), model.params)
+        per = len(pi) - 10  # the platform's ten last
+        per_leg = [list(row) for row in pi[:per].reshape(len(s.legs), -1)]
+        letters: tuple[str, ...] = s.legs
+    else:
+        per_leg, letters = _general_legs(model), LEGS
     first = np.array(per_leg[0])
-    for leg, values in zip(LEGS[1:], per_leg[1:], strict=True):
+    for leg, values in zip(letters[1:], per_leg[1:], strict=True):
         if not np.allclose(values, first, rtol=1e-12, atol=1e-15):
             raise InputError(
                 f"identical_legs: leg {leg}'s inertial parameters differ from leg A's "
@@ -181,28 +227,29 @@ def _check_identical_legs(model: Model) -> None:
             )
 
 
-def _check_names(model: Model) -> None:
-    """The generated regressor's columns are :data:`INERTIAL_PARAMETER_NAMES`."""
+def _check_names(model: Model) -> tuple[str, ...]:
+    """The generated regressor's columns are :func:`inertial_parameter_names`' (returned)."""
     variant = variants.load(model.structure, model.generated)
     names = variant.tables.get(f"{variant.prefix}_inertial_parameter_names")
-    if names != INERTIAL_PARAMETER_NAMES:
+    expected = inertial_parameter_names(model)
+    if names != expected:
         raise Rpr3genError(
             f"{variant.folder}: the generated regressor's columns are not this runtime's "
-            "INERTIAL_PARAMETER_NAMES (regenerate with rpr3gen generate)"
+            "inertial parameter names (regenerate with rpr3gen generate)"
         )
+    return expected
 
 
 def regressor_and_codes(
     model: Model, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, backend: str
 ) -> tuple[np.ndarray, np.ndarray]:
-    """The per-leg regressor ``Y`` (n, 3, 28) and each sample's return code (0: evaluated)."""
-    planar_only(model.structure, "the regressor")
-    _check_names(model)
+    """The per-leg regressor ``Y`` (n, k, P) and each sample's return code (0: evaluated)."""
+    names = _check_names(model)
     (Y,), codes = evaluate(model, "regressor", (q, qd, qdd), backend)
-    return Y.reshape(-1, 3, len(INERTIAL_PARAMETER_NAMES)), codes
+    return Y.reshape(-1, model.structure.dof, len(names)), codes
 
 
-@checked(q=Rows(3), qd=Rows(3), qdd=Rows(3), same_length=[("q", "qd", "qdd")])
+@checked(q=PoseRows(), qd=PoseRows(), qdd=PoseRows(), same_length=[("q", "qd", "qdd")])
 def regressor(
     model: Model,
     q: ArrayLike,
@@ -211,18 +258,22 @@ def regressor(
     identical_legs: bool = False,
     backend: str = "numpy",
 ) -> np.ndarray:
-    """``Y`` (n, 3, P): ``tau = Y @ pi + tau_payload`` for each sample (generated, eqs. 10-17).
+    """``Y`` (n, k, P): ``tau = Y @ pi + tau_payload`` for each sample (generated, eqs. 10-17).
 
-    Rows: the efforts of legs A, B, C (``m10_*`` or ``f21z_*``); columns: :func:`parameter_names`.
-    A singular pose gives a NaN row, as :func:`rpr3gen.inverse_dynamics` refuses it.
+    Rows: the efforts of legs A, B, C (``m10_*`` or ``f21z_*``; a hexapod's A to F); columns:
+    :func:`inertial_parameter_names`. A singular pose gives a NaN row, as
+    :func:`rpr3gen.inverse_dynamics` refuses it. A spatial robot's column ``j`` is its inverse
+    dynamics' efforts for the model numbers whose ``pi`` is ``e_j`` (``P`` evaluations).
 
     Raises:
         InputError: ``identical_legs`` with a general model whose legs' parameters differ.
     """
+    s = model.structure
+    match_width(s.dof, s.title, q=np.asarray(q), qd=np.asarray(qd), qdd=np.asarray(qdd))
     if identical_legs:
         _check_identical_legs(model)
     Y, _ = regressor_and_codes(model, q, qd, qdd, backend)
-    return Y @ shared_matrix() if identical_legs else Y
+    return Y @ shared_matrix(model) if identical_legs else Y
 
 
 @checked(q=PoseRows())
@@ -285,9 +336,12 @@ class BaseParameters:
 
 
 def _excitation_samples(model: Model, count: int) -> tuple[np.ndarray, ...]:
-    """``count`` random poses near the central configuration, with random velocities and
-    accelerations (a fixed seed: the same samples for the same model)."""
+    """``count`` random poses near the central configuration (a spatial robot's: near home),
+    with random velocities and accelerations (a fixed seed: the same samples for the same
+    model)."""
     rng = np.random.default_rng(20130)  # Briot and Gautier, 2013
+    if model.structure.spatial:
+        return _spatial_samples(model, count, rng)
     rho = platform_radius(model)
     q = rng.uniform(-1.0, 1.0, (count, 3)) * np.array([0.15 * rho, 0.15 * rho, 0.25])
     qd = rng.normal(0.0, 1.0, (count, 3)) * np.array([rho, rho, 1.0])
@@ -295,11 +349,28 @@ def _excitation_samples(model: Model, count: int) -> tuple[np.ndarray, ...]:
     return q, qd, qdd
 
 
+def _spatial_samples(
+    model: Model, count: int, rng: np.random.Generator
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A spatial robot's: translations within a tenth of its shortest leg (home to platform
+    point) and, for a hexapod, turns within 0.15 rad, around home."""
+    s = model.structure
+    p = model.params
+    size = min(
+        float(np.linalg.norm([p[f"p{a}_{leg}"] - p[f"b{a}_{leg}"] for a in "xyz"]))
+        for leg in s.legs
+    )
+    scale = np.array([0.1 * size] * 3 + [0.15] * (s.dof - 3))
+    q = rng.uniform(-1.0, 1.0, (count, s.dof)) * scale
+    qd = rng.normal(0.0, 1.0, (count, s.dof)) * scale * 10.0
+    qdd = rng.normal(0.0, 1.0, (count, s.dof)) * scale * 50.0
+    return q, qd, qdd
+
+
 @lru_cache(maxsize=32)
 @one_blas_thread
 def _base_parameters(model: Model, identical_legs: bool) -> BaseParameters:
-    planar_only(model.structure, "the base parameters")
-    names = parameter_names(identical_legs)
+    names = inertial_parameter_names(model, identical_legs)
     q, qd, qdd = _excitation_samples(model, 120)
     Y = regressor(model, q, qd, qdd, identical_legs)
     Y = Y[np.isfinite(Y).all(axis=(1, 2))]
@@ -311,17 +382,16 @@ def _base_parameters(model: Model, identical_legs: bool) -> BaseParameters:
     scale = np.linalg.norm(W, axis=0)
     rtol = 1e-9
     unidentifiable = tuple(n for n, s in zip(names, scale, strict=True) if s <= rtol * scale.max())
-    order = [names.index(n) for n in _preference(identical_legs)]
+    # A column that is round-off (a translating platform's first moments: ~1e-16 of the
+    # others) would take a direction of its own in the QR below: left out of it.
+    order = [names.index(n) for n in _preference(model, identical_legs) if n not in unidentifiable]
     # QR without pivoting in the order of preference: a column is dependent on the ones before
     # it when what remains of it is round-off against its norm.
     import scipy.linalg  # here, not at the top: `import rpr3gen` (every command) stays quick
 
     R = scipy.linalg.qr(W[:, order], mode="r")[0]
     base = sorted(
-        order[k]
-        for k in range(len(order))
-        if abs(R[k, k]) > 1e-8 * max(scale[order[k]], 1e-300)
-        and names[order[k]] not in unidentifiable
+        order[k] for k in range(len(order)) if abs(R[k, k]) > 1e-8 * max(scale[order[k]], 1e-300)
     )
     dependent = [j for j in range(len(names)) if j not in base]
     beta = np.linalg.lstsq(W[:, base], W[:, dependent], rcond=None)[0]
@@ -364,7 +434,7 @@ def base_parameters(model: Model, identical_legs: bool = False) -> BaseParameter
     return _base_parameters(model, bool(identical_legs))
 
 
-@checked(q=Rows(3), qd=Rows(3), qdd=Rows(3), same_length=[("q", "qd", "qdd")])
+@checked(q=PoseRows(), qd=PoseRows(), qdd=PoseRows(), same_length=[("q", "qd", "qdd")])
 def base_regressor(
     model: Model,
     q: ArrayLike,
@@ -373,7 +443,7 @@ def base_regressor(
     identical_legs: bool = False,
     backend: str = "numpy",
 ) -> np.ndarray:
-    """``Yb`` (n, 3, B): ``Y @ pi == Yb @ (base.matrix @ pi)``; the base parameters' columns."""
+    """``Yb`` (n, k, B): ``Y @ pi == Yb @ (base.matrix @ pi)``; the base parameters' columns."""
     base = base_parameters(model, identical_legs)
     Y = regressor(model, q, qd, qdd, identical_legs, backend)
     return Y[..., list(base.columns)]

@@ -196,14 +196,22 @@ def sweep_cost(
     area_resolution: int,
     processes: int,
     block: int,
+    *,
+    points: int | None = None,
+    sample_bytes: int = STACKED_SAMPLE,
 ) -> int:
     """Bytes of a sweep: the table of every design read back at the end, a task per chunk on
     Dask, and ``processes`` tasks at once, each evaluating at least ``block`` stacked samples of
     the trajectories and (``area_resolution`` > 0) ``4 block`` of the area grid.
+
+    ``points``: the poses of each design's workspace grid, when not ``area_resolution`` squared
+    (a spatial robot's volume: its resolution cubed); ``sample_bytes``: a design x sample of the
+    stacked evaluation, when not a planar robot's (:data:`STACKED_SAMPLE`).
     """
-    per_task = max(block, samples) * STACKED_SAMPLE + chunk_size * DESIGN_ROW
-    if area_resolution:
-        per_task += max(4 * block, area_resolution * area_resolution) * STACKED_SAMPLE
+    points = area_resolution * area_resolution if points is None else points
+    per_task = max(block, samples) * sample_bytes + chunk_size * DESIGN_ROW
+    if points:
+        per_task += max(4 * block, points) * sample_bytes
     tasks = ceil_div(designs, chunk_size) * TASK
     return designs * DESIGN_ROW + tasks + processes * (WORKER + per_task)
 

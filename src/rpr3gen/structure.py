@@ -198,6 +198,21 @@ class Structure:
         """The output family of the actuator coordinates."""
         return self.coordinate(self.actuated)
 
+    def limited_coordinates(self) -> tuple[str, ...]:
+        """The joint coordinates a model's ``[limits]`` may bound, per leg (``q2``; a U's
+        ``q1a``, ``q1b``): every R, P and U joint's (a spatial robot's S joints have none).
+        The paper's format bounds its pistons with ``stroke`` instead: none."""
+        if self.paper:
+            return ()
+        if not self.spatial:
+            return ("q1", "q2", "q3")
+        if self.leg.endswith("SS2"):
+            return ("q1",)
+        out: list[str] = []
+        for j, kind in enumerate(self.leg[:2], start=1):
+            out += [f"q{j}a", f"q{j}b"] if kind == "U" else [f"q{j}"]
+        return tuple(out)
+
     def param_names(self) -> tuple[str, ...]:
         """The parameter vector of the structure's variant, in order (docs/interfaces.md)."""
         if self.paper:

@@ -16,7 +16,7 @@ import difflib
 import math
 import os
 import warnings
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from types import MappingProxyType
 from typing import TextIO
@@ -355,16 +355,7 @@ def _parse(
         where = f"{source}: line {reader.line_num} (data row {len(values) + 1})"
         if len(row) != len(header):
             raise TrajectoryError(f"{where}: has {len(row)} fields, the header has {len(header)}")
-        numbers = []
-        for name, col in zip(columns, wanted, strict=True):
-            cell = row[col].strip()
-            try:
-                x = float(cell)
-            except ValueError:
-                raise TrajectoryError(f"{where}, column {name!r}: not a number: {cell!r}") from None
-            if not math.isfinite(x):
-                raise TrajectoryError(f"{where}, column {name!r}: not finite: {cell!r}")
-            numbers.append(x)
+        numbers = row_numbers(row, zip(columns, wanted, strict=True), where)
         if values and numbers[0] <= values[-1][0]:
             raise TrajectoryError(
                 f"{where}, column 't': time {numbers[0]!r} is not greater than the previous "
@@ -375,6 +366,22 @@ def _parse(
         raise TrajectoryError(f"{source}: no data rows after the header")
 
     return np.array(values, dtype=np.float64)
+
+
+def row_numbers(row: Sequence[str], columns: Iterable[tuple[str, int]], where: str) -> list[float]:
+    """The finite numbers of a CSV ``row`` at ``columns`` (``(name, index)``), or a
+    :class:`TrajectoryError` naming ``where`` and the column."""
+    out = []
+    for name, col in columns:
+        cell = row[col].strip()
+        try:
+            x = float(cell)
+        except ValueError:
+            raise TrajectoryError(f"{where}, column {name!r}: not a number: {cell!r}") from None
+        if not math.isfinite(x):
+            raise TrajectoryError(f"{where}, column {name!r}: not finite: {cell!r}")
+        out.append(x)
+    return out
 
 
 def write_trajectory_csv(

@@ -345,14 +345,17 @@ def match_width(width: int, title: str, **arrays: np.ndarray) -> None:
 
 class Reading(Check):
     """One reading of ``size`` numbers, shape ``(size,)`` exactly: ``(2, size)`` is refused, not
-    cut to its first row. ``finite``: no NaN or infinity; ``positive``: every value > 0."""
+    cut to its first row (``size`` None: any length, matched to the model by the caller).
+    ``finite``: no NaN or infinity; ``positive``: every value > 0."""
 
-    def __init__(self, size: int, *, finite: bool = False, positive: bool = False) -> None:
+    def __init__(self, size: int | None, *, finite: bool = False, positive: bool = False) -> None:
         self.size, self.finite, self.positive = size, finite, positive
 
     def __call__(self, name: str, value: Any) -> np.ndarray:
         array = numbers(name, value)
-        if array.shape != (self.size,):
+        if self.size is None and array.ndim == 1:
+            pass  # any length: the caller matches it to the model
+        elif array.shape != (self.size,):
             several = "; several readings take one call each" if array.ndim == 2 else ""
             raise _value_error(name, f"must have shape ({self.size},), got {array.shape}{several}")
         if (self.finite or self.positive) and not np.isfinite(array).all():

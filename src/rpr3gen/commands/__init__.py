@@ -18,6 +18,7 @@ from rpr3gen.commands import (
     identify,
     paper,
     params,
+    retime,
     simulate,
     sweep,
     workspace,
@@ -34,6 +35,7 @@ COMMANDS = (
     workspace,
     sweep,
     export,
+    retime,
     generate,
 )
 """Every command module, in the order of ``rpr3gen --help``."""

@@ -18,9 +18,8 @@ import numpy as np
 from rpr3gen.atomic import atomic_write
 from rpr3gen.commands import options
 from rpr3gen.commands.args import number
-from rpr3gen.model import LEGS, Model, load_model
+from rpr3gen.model import Model, load_model
 from rpr3gen.paths import check_output
-from rpr3gen.structure import planar_only
 
 if TYPE_CHECKING:  # imported when needed, as below: `import rpr3gen.cli` stays light
     from rpr3gen.identification import Fit
@@ -39,7 +38,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         description="Weighted least squares of the base parameters (docs/identification.md) on "
         "a data CSV: a trajectory file (t,x,y,phi and optionally the derivatives, which a "
         "smoothing spline estimates otherwise) plus the measured efforts m10_A,m10_B,m10_C "
-        "(revolute actuation) or f21z_A,f21z_B,f21z_C (prismatic). Prints each estimate, its "
+        "(revolute actuation) or f21z_A,f21z_B,f21z_C (prismatic); a general or spatial "
+        "model's tau_A,tau_B,... (a spatial model's file has its pose's columns, e.g. "
+        "t,x,y,z,a,b,c for a hexapod). Prints each estimate, its "
         "standard deviation, the model's value and the combination it stands for.",
     )
     options.add_model(parser)
@@ -50,7 +51,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     parser.add_argument(
         "--identical-legs",
         action="store_true",
-        help="the three legs share one set of parameters (9 base parameters instead of 19)",
+        help="the legs share one set of parameters (the paper's robot: 9 base parameters "
+        "instead of 19)",
     )
     options.add_smoothing(parser)
     parser.add_argument(
@@ -132,12 +134,11 @@ def run(args: argparse.Namespace) -> int:
 
     model = load_model(args.model)
 
-    planar_only(model.structure, "rpr3gen identify")
     if args.out:
         check_output(args.out, "the estimates", argument="out")
-    family = model.structure.effort
-    columns = tuple(f"{family}_{leg}" for leg in LEGS)
-    traj, tau = read_trajectory_columns(args.data, columns, smoothing=args.smoothing)
+    s = model.structure
+    columns = tuple(f"{s.effort}_{leg}" for leg in s.legs)
+    traj, tau = read_trajectory_columns(args.data, columns, smoothing=args.smoothing, pose=s.pose)
     fit = identify(
         model,
         traj.q,
@@ -161,12 +162,12 @@ def run(args: argparse.Namespace) -> int:
     base_values = _model_base(fit)
     expressions = fit.base.expressions(4)
     per = ", ".join(
-        f"{leg} {r:.4g}" for leg, r in zip(LEGS, fit.residual_rms_per_actuator, strict=True)
+        f"{leg} {r:.4g}" for leg, r in zip(s.legs, fit.residual_rms_per_actuator, strict=True)
     )
     print(
         f"identify: {fit.samples} samples of {args.data}, model {model.name} "
         f"({what}), {len(fit.base.names)} base parameters ({legs})"
-        + (" + 6 friction" if args.friction else "")
+        + (f" + {2 * len(s.legs)} friction" if args.friction else "")
     )
     print(
         f"  condition number {fit.condition_number:.4g} (warns above {args.warn_condition:g}, "

@@ -1,5 +1,6 @@
 """``rpr3gen sweep``: every design of a grid of model keys evaluated over trajectories (on Dask),
-one Parquet row per design: feasibility, peak and RMS efforts, joint loads, conditioning, area."""
+one Parquet row per design: feasibility, peak and RMS efforts, joint loads, conditioning, and
+the workspace area (planar robots) or volume (spatial robots)."""
 
 from __future__ import annotations
 
@@ -11,6 +12,7 @@ from rpr3gen.design.sweeps import (
     DEFAULT_AREA_RESOLUTION,
     DEFAULT_CHUNK_SIZE,
     DEFAULT_TRAJECTORIES,
+    DEFAULT_VOLUME_RESOLUTION,
 )
 from rpr3gen.trajectory import DEFAULT_DURATION, DEFAULT_SAMPLES
 
@@ -25,7 +27,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         description="For every design of GRID.toml (dotted model keys set to lists or "
         "{start, stop, num} ranges, applied to BASE.toml): feasible or not and why, peak and "
         "RMS actuator efforts, peak joint loads, least conditioning and the workspace area at "
-        "phi = 0; one row per design, in the grid's order.",
+        "phi = 0 (a spatial robot, hexapod or Delta: its workspace volume at the home "
+        "orientation); one row per design, in the grid's order. A spatial robot needs its own "
+        "trajectory: --trajectory FILE.csv.",
     )
     options.add_model(parser, metavar="BASE.toml", what="base model")
     parser.add_argument("--grid", required=True, metavar="GRID.toml", help="the designs (required)")
@@ -35,7 +39,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         dest="trajectories",
         metavar=options.TRAJECTORY,
         help="'rotation', 'rectilinear' or a trajectory CSV file; repeat for several "
-        "(default: rotation and rectilinear)",
+        "(default: rotation and rectilinear, the paper's planar motions; a spatial robot "
+        "needs a CSV file of its pose)",
     )
     options.add_samples(parser, "each paper trajectory", default=DEFAULT_SAMPLES)
     options.add_duration(parser, "each paper trajectory", default=DEFAULT_DURATION)
@@ -75,8 +80,25 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         type=integer(0),
         default=DEFAULT_AREA_RESOLUTION,
         metavar="N",
-        help="grid points per axis of each design's workspace area; 0: no area "
+        help="planar robots: grid points per axis of each design's workspace area; 0: no area "
         f"(default: {DEFAULT_AREA_RESOLUTION})",
+    )
+    parser.add_argument(
+        "--volume-resolution",
+        type=integer(0),
+        default=DEFAULT_VOLUME_RESOLUTION,
+        metavar="N",
+        help="spatial robots: grid points per axis (x, y and z) of each design's workspace "
+        "volume at the home orientation, over the box of 'rpr3gen workspace'; 0: no volume "
+        f"(default: {DEFAULT_VOLUME_RESOLUTION})",
+    )
+    parser.add_argument(
+        "--backend",
+        choices=("numpy", "c"),
+        default="numpy",
+        help="spatial robots: evaluate the generated NumPy code (designs x samples in each "
+        "call) or the C code (one batch call per design, compiled on first use in each "
+        "worker); a planar robot's sweep is NumPy's (default: numpy)",
     )
     options.add_min_conditioning(parser, "a pose below this conditioning makes a design infeasible")
 
@@ -101,6 +123,8 @@ def run(args: argparse.Namespace) -> int:
             samples=args.samples,
             duration=args.duration,
             progress=True,
+            volume_resolution=args.volume_resolution,
+            backend=args.backend,
         )
     except SweepInterrupted as exc:  # main prints it as one line: what is kept, how to go on
         raise KeyboardInterrupt(

@@ -9,6 +9,10 @@
 Both take a model of either format (the paper's 3-RPR, or the general one of any leg type),
 evaluate the generated NumPy code with one parameter vector per sample (:mod:`.stacked`), and
 count a pose reachable as :mod:`.reach` says (with its default limits for design studies).
+
+A spatial robot (a hexapod or a Delta) has its own workspace (:func:`spatial_workspace`), and
+its sweeps its own grid keys (:mod:`.spatial_grid`) and measures (:mod:`.spatial_metrics`: the
+workspace volume in place of the area), in NumPy or C.
 """
 
 from rpr3gen.design.maps import WorkspaceMap, workspace

@@ -22,6 +22,10 @@ A base model of the general format (any leg type) has its own keys::
 
 With ``symmetric = true`` only leg A's keys exist (legs B and C are leg A turned).
 
+A spatial base model (a hexapod or a Delta) has its file's keys, indexed the same way
+(``"legs.A.base[2]"``, ``"platform.inertia[0]"``, ``"legs.A.rod_mass"``):
+:mod:`rpr3gen.design.spatial_grid`.
+
 Every key and every value is checked before any work: an unknown key (with the close match), a
 value that is not a list or a range, or a value that makes the base model invalid is a
 :class:`~rpr3gen.errors.GridError` naming the file and the key.
@@ -29,10 +33,8 @@ value that is not a list or a range, or a value that makes the base model invali
 
 from __future__ import annotations
 
-import copy
 import math
 import os
-import re
 import tomllib
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -42,9 +44,12 @@ from typing import Any
 import numpy as np
 
 from rpr3gen import sizes
+from rpr3gen.design.grid_keys import check_index, get_value, set_value, show, split_key
+from rpr3gen.design.spatial_grid import SPATIAL_LIST_DEFAULTS, check_spatial_key, turn_u_axes
 from rpr3gen.errors import GridError, ModelError, did_you_mean
 from rpr3gen.model import ACTUATIONS, DEFAULT_GRAVITY, MODEL_KEYS, Model, model_from_dict
 from rpr3gen.model.general import LEG_KEYS, is_general
+from rpr3gen.model.spatial import is_spatial
 from rpr3gen.structure import LEGS
 
 __all__ = ["Grid", "read_grid"]
@@ -82,7 +87,6 @@ _NOT_PARAMETERS = ("name", "leg", "symmetric")
 _TEXT_KEYS = ("actuation",)
 _INTEGER_KEYS = ("actuated",)
 _RANGE_KEYS = ("start", "stop", "num")
-_KEY = re.compile(r"^(?P<key>[A-Za-z_][A-Za-z0-9_.]*?)(?P<index>(\[\d+\])*)$")
 
 
 @dataclass(frozen=True)
@@ -127,8 +131,12 @@ class Grid:
         """A copy of the model data ``base`` with the keys set to ``values``."""
         # Tables are copied; leaves are replaced, never changed in place (lists by _set).
         data = {k: dict(v) if isinstance(v, Mapping) else v for k, v in base.items()}
+        spatial = is_spatial(base)
+        defaults = SPATIAL_LIST_DEFAULTS if spatial else _LIST_DEFAULTS
         for key, value in zip(self.keys, values, strict=True):
-            _set(data, key, value)
+            set_value(data, key, value, defaults)
+        if spatial:  # a moved leg turns its U (rpr3gen.design.spatial_grid)
+            turn_u_axes(data, base, self.keys)
         return data
 
     def as_dict(self) -> dict[str, list[Any]]:
@@ -158,7 +166,13 @@ def read_grid(grid: str | os.PathLike[str] | Mapping[str, Any], base: Mapping[st
             f'{source}: no keys; set model keys to values, e.g. "geometry.r" = [0.25, 0.3]'
         )
     keys, values = [], []
-    check = _check_general_key if is_general(base) else _check_key
+    check = (
+        check_spatial_key
+        if is_spatial(base)
+        else _check_general_key
+        if is_general(base)
+        else _check_key
+    )
     for key, given in flat.items():
         check(key, base, source)
         keys.append(key)
@@ -168,7 +182,7 @@ def read_grid(grid: str | os.PathLike[str] | Mapping[str, Any], base: Mapping[st
         for value in vals:
             try:
                 data_ = Grid((key,), ((value,),)).apply(base, (value,))
-                model_from_dict(data_, source=f"{source}: {key} = {_show(value)}")
+                model_from_dict(data_, source=f"{source}: {key} = {show(value)}")
             except ModelError as exc:
                 raise GridError(str(exc)) from None
     return grid_
@@ -218,17 +232,8 @@ def _flatten(table: Mapping[str, Any], prefix: str, flat: dict[str, Any], source
             flat[dotted] = value
 
 
-def _split(key: str) -> tuple[str, tuple[int, ...]]:
-    """``"geometry.base[1][0]"`` -> ``("geometry.base", (1, 0))``."""
-    found = _KEY.match(key)
-    if found is None:
-        return key, ()
-    index = tuple(int(i) for i in re.findall(r"\[(\d+)\]", found["index"]))
-    return found["key"], index
-
-
 def _check_key(key: str, base: Mapping[str, Any], source: str) -> None:
-    name, index = _split(key)
+    name, index = split_key(key)
     if name not in MODEL_KEYS:
         hint = did_you_mean(name, MODEL_KEYS)
         raise GridError(f"{source}: {key}: unknown model key{hint}")
@@ -239,8 +244,8 @@ def _check_key(key: str, base: Mapping[str, Any], source: str) -> None:
         if index:
             raise GridError(f"{source}: {key}: {name} holds one value, not a list")
         return
-    _check_index(key, name, index, shape, source)
-    if _get(base, name) is None and name not in _LIST_DEFAULTS:
+    check_index(key, name, index, shape, source)
+    if get_value(base, name) is None and name not in _LIST_DEFAULTS:
         raise GridError(
             f"{source}: {key}: the base model has no {name} to vary; set it in the model file"
         )
@@ -271,7 +276,7 @@ def _general_shape(name: str) -> tuple[int, ...] | None:
 
 
 def _check_general_key(key: str, base: Mapping[str, Any], source: str) -> None:
-    name, index = _split(key)
+    name, index = split_key(key)
     if name in _NOT_PARAMETERS:
         raise GridError(f"{source}: {key}: not a design parameter")
     known = general_keys(base)
@@ -294,7 +299,7 @@ def _check_general_key(key: str, base: Mapping[str, Any], source: str) -> None:
         if index:
             raise GridError(f"{source}: {key}: {name} holds one value, not a list")
         return
-    _check_index(key, name, index, shape, source)
+    check_index(key, name, index, shape, source)
     if name.endswith(".axes"):
         leg = base.get("leg")
         if isinstance(leg, str) and len(leg) == 3 and leg[index[0]] == "R":
@@ -302,21 +307,10 @@ def _check_general_key(key: str, base: Mapping[str, Any], source: str) -> None:
                 f"{source}: {key}: joint {index[0] + 1} of a 3-{leg} is revolute; its axis "
                 "is ignored"
             )
-    if _get(base, name) is None and name not in _LIST_DEFAULTS:
+    if get_value(base, name) is None and name not in _LIST_DEFAULTS:
         raise GridError(
             f"{source}: {key}: the base model has no {name} to vary; set it in the model file"
         )
-
-
-def _check_index(
-    key: str, name: str, index: tuple[int, ...], shape: tuple[int, ...], source: str
-) -> None:
-    if len(index) != len(shape):
-        example = name + "".join("[0]" for _ in shape)
-        raise GridError(f'{source}: {key}: {name} holds a list; vary one element, e.g. "{example}"')
-    for i, n in zip(index, shape, strict=True):
-        if i >= n:
-            raise GridError(f"{source}: {key}: index {i} out of range (0 to {n - 1})")
 
 
 def _values(key: str, given: Any, source: str) -> tuple[Any, ...]:
@@ -329,7 +323,7 @@ def _values(key: str, given: Any, source: str) -> tuple[Any, ...]:
     if not isinstance(given, list):
         raise GridError(
             f"{source}: {key}: must be a list of values or a range "
-            f"{{ start = ..., stop = ..., num = ... }}, got {_show(given)}"
+            f"{{ start = ..., stop = ..., num = ... }}, got {show(given)}"
         )
     if not given:
         raise GridError(f"{source}: {key}: an empty list; give at least one value")
@@ -337,18 +331,18 @@ def _values(key: str, given: Any, source: str) -> tuple[Any, ...]:
     for i, value in enumerate(given):
         if text:
             if not isinstance(value, str):
-                raise GridError(f"{source}: {key}[{i}]: must be text, got {_show(value)}")
+                raise GridError(f"{source}: {key}[{i}]: must be text, got {show(value)}")
             if value not in ACTUATIONS:
                 hint = did_you_mean(value, ACTUATIONS)
                 raise GridError(
                     f"{source}: {key}[{i}]: must be one of {', '.join(ACTUATIONS)}, "
-                    f"got {_show(value)}{hint}"
+                    f"got {show(value)}{hint}"
                 )
             out.append(value)
         elif key in _INTEGER_KEYS:
             if isinstance(value, bool) or value not in (1, 2, 3):
                 raise GridError(
-                    f"{source}: {key}[{i}]: must be the joint 1, 2 or 3, got {_show(value)}"
+                    f"{source}: {key}[{i}]: must be the joint 1, 2 or 3, got {show(value)}"
                 )
             out.append(int(value))
         else:
@@ -370,7 +364,7 @@ def _range(key: str, given: Mapping[str, Any], source: str) -> tuple[float, ...]
     stop = _number(f"{key}.stop", given["stop"], source)
     num = given["num"]
     if isinstance(num, bool) or not isinstance(num, int) or num < 1:
-        raise GridError(f"{source}: {key}.num: must be an integer >= 1, got {_show(num)}")
+        raise GridError(f"{source}: {key}.num: must be an integer >= 1, got {show(num)}")
     sizes.check(f"{source}: {key}.num", num, lambda n: n * sizes.DESIGN_ROW,
                 "the grid's designs", least=1, error=GridError)  # fmt: skip
     return tuple(float(v) for v in np.linspace(start, stop, num))
@@ -378,63 +372,11 @@ def _range(key: str, given: Mapping[str, Any], source: str) -> tuple[float, ...]
 
 def _number(where: str, value: Any, source: str) -> float:
     if isinstance(value, bool) or not isinstance(value, int | float):
-        raise GridError(f"{source}: {where}: must be a number, got {_show(value)}")
+        raise GridError(f"{source}: {where}: must be a number, got {show(value)}")
     try:
         number = float(value)
     except OverflowError:  # a TOML integer beyond float64
         number = math.inf
     if not math.isfinite(number):
-        raise GridError(f"{source}: {where}: must be a finite number, got {_show(value)}")
+        raise GridError(f"{source}: {where}: must be a finite number, got {show(value)}")
     return number
-
-
-def _show(value: Any) -> str:
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, str):
-        return f'"{value}"'
-    if isinstance(value, Mapping):
-        return "a table"
-    if isinstance(value, list):
-        return f"a list of {len(value)}"
-    text = repr(value)  # a TOML integer may have hundreds of digits
-    return text if len(text) <= 40 else f"{text[:37]}..."
-
-
-def _path(name: str) -> list[str]:
-    """The tables and the key of a dotted model key: ``"legs.A.mass"`` -> ``["legs", "A",
-    "mass"]``; a ``[limits]`` key keeps its dot (``"limits.A.q2"`` -> ``["limits", "A.q2"]``)."""
-    if name.startswith("limits."):
-        return ["limits", name[len("limits.") :]]
-    return name.split(".")
-
-
-def _get(data: Mapping[str, Any], name: str) -> Any:
-    inner: Any = data
-    for part in _path(name):
-        if not isinstance(inner, Mapping):
-            return None
-        inner = inner.get(part)
-    return inner
-
-
-def _set(data: dict[str, Any], key: str, value: Any) -> None:
-    name, index = _split(key)
-    *tables, leaf = _path(name)
-    inner = data
-    for table in tables:  # copied on the way: the base model's tables are never changed
-        child = inner.get(table)
-        inner[table] = dict(child) if isinstance(child, Mapping) else {}
-        inner = inner[table]
-    if not index:
-        inner[leaf] = value
-        return
-    current = inner.get(leaf)
-    if current is None:
-        current = copy.deepcopy(_LIST_DEFAULTS[name])
-    current = copy.deepcopy(list(current))
-    inner[leaf] = current
-    for i in index[:-1]:
-        current[i] = list(current[i])
-        current = current[i]
-    current[index[-1]] = value

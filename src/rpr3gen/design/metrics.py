@@ -14,12 +14,14 @@ The designs are evaluated together: each generated call takes designs x samples,
 column per sample (:mod:`rpr3gen.design.stacked`). Designs whose structure (the paper's
 actuation, a general model's actuated joint) differs use different generated code, so a chunk is
 evaluated per structure.
+
+A spatial base model (a hexapod or a Delta) is measured by :mod:`rpr3gen.design.spatial_metrics`
+(:func:`evaluate_chunk` hands its chunks over).
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -29,6 +31,7 @@ from rpr3gen.backends import BLOCK
 from rpr3gen.design.grid import Grid
 from rpr3gen.design.grid import design_model as grid_model
 from rpr3gen.design.maps import cell_centres
+from rpr3gen.design.plan import SweepPlan
 from rpr3gen.design.reach import (
     bounds,
     design_limits,
@@ -38,12 +41,12 @@ from rpr3gen.design.reach import (
     reachable,
     within,
 )
+from rpr3gen.design.reductions import least, peak, trajectory_samples
+from rpr3gen.design.spatial_metrics import evaluate_spatial_chunk
 from rpr3gen.design.stacked import evaluate_stacked, param_rows
 from rpr3gen.errors import ModelError
 from rpr3gen.model import LEGS, Model
-from rpr3gen.model.general import is_general
 from rpr3gen.policy import invalid_samples
-from rpr3gen.trajectory import Trajectory
 
 __all__ = [
     "GENERAL_JOINT_COLUMNS",
@@ -92,46 +95,6 @@ _DEFAULT_LIMIT = "(the design studies' default travel; set [limits] in the model
 _AREA_BLOCK = 4 * BLOCK
 
 
-@dataclass(frozen=True)
-class SweepPlan:
-    """Everything a worker needs to evaluate any chunk of a sweep (picklable).
-
-    Attributes:
-        base: the base model's data (parsed TOML).
-        base_source: its name, for messages.
-        grid: the designs.
-        names: the trajectories' names, for the reasons.
-        trajectories: the trajectories, in the order given.
-        min_conditioning: the least conditioning of a feasible pose.
-        area_resolution: grid points per axis of the workspace area (0: no area, NaN).
-        chunk_size: designs per chunk.
-    """
-
-    base: dict[str, Any]
-    base_source: str
-    grid: Grid
-    names: tuple[str, ...]
-    trajectories: tuple[Trajectory, ...]
-    min_conditioning: float
-    area_resolution: int
-    chunk_size: int
-
-    @property
-    def general(self) -> bool:
-        """The base model is of the general format."""
-        return is_general(self.base)
-
-    @property
-    def chunks(self) -> int:
-        """Number of chunks."""
-        return -(-len(self.grid) // self.chunk_size)
-
-    def chunk(self, index: int) -> range:
-        """The designs of chunk ``index``."""
-        start = index * self.chunk_size
-        return range(start, min(start + self.chunk_size, len(self.grid)))
-
-
 def result_columns(grid: Grid, general: bool = False) -> tuple[str, ...]:
     """Every column of a sweep's output, in order: the grid's keys, then
     :data:`RESULT_COLUMNS` (a base model of the general format: :data:`GENERAL_RESULT_COLUMNS`).
@@ -142,10 +105,14 @@ def result_columns(grid: Grid, general: bool = False) -> tuple[str, ...]:
 def evaluate_chunk(plan: SweepPlan, index: int) -> tuple[int, dict[str, Any]]:
     """Evaluate chunk ``index`` of ``plan``: ``(index, {column: values})``, one row per design.
 
-    The columns are :func:`result_columns`: float64 arrays, ``feasible`` bool, ``reason`` (and
-    ``actuation`` when varied) object arrays of text. A design whose values make an invalid
-    model is infeasible, its reason the model's error, its numbers NaN.
+    The columns are :func:`result_columns` (a spatial base model's:
+    :func:`rpr3gen.design.spatial_metrics.spatial_result_columns`): float64 arrays,
+    ``feasible`` bool, ``reason`` (and ``actuation`` when varied) object arrays of text. A
+    design whose values make an invalid model is infeasible, its reason the model's error, its
+    numbers NaN.
     """
+    if plan.spatial:
+        return evaluate_spatial_chunk(plan, index)
     designs = plan.chunk(index)
     n = len(designs)
     columns: dict[str, Any] = plan.grid.columns(designs.start, designs.stop)
@@ -173,32 +140,11 @@ def evaluate_chunk(plan: SweepPlan, index: int) -> tuple[int, dict[str, Any]]:
     return index, columns
 
 
-def _samples(plan: SweepPlan) -> tuple[np.ndarray, ...]:
-    """Every trajectory's samples one after the other: q, qd, qdd (S, 3), the trajectory of
-    each sample (S,), its time (S,) and its time weight (S,), the trapezoid rule's."""
-    weights = []
-    for traj in plan.trajectories:
-        if len(traj) == 1:
-            weights.append(np.ones(1))
-            continue
-        dt = np.diff(traj.t)
-        weights.append(np.concatenate([[dt[0]], dt[1:] + dt[:-1], [dt[-1]]]) / 2)
-    which = np.concatenate([np.full(len(tr), i) for i, tr in enumerate(plan.trajectories)])
-    return (
-        np.concatenate([tr.q for tr in plan.trajectories]),
-        np.concatenate([tr.qd for tr in plan.trajectories]),
-        np.concatenate([tr.qdd for tr in plan.trajectories]),
-        which,
-        np.concatenate([tr.t for tr in plan.trajectories]),
-        np.concatenate(weights),
-    )
-
-
 def _trajectory_metrics(
     plan: SweepPlan, models: Sequence[Model], rows: np.ndarray, results: dict[str, Any]
 ) -> None:
     """Fill the trajectory columns of ``results`` at ``rows`` for ``models`` (one structure)."""
-    q, qd, qdd, which, t, weight = _samples(plan)
+    q, qd, qdd, which, t, weight = trajectory_samples(plan)
     S = q.shape[0]
     params = param_rows(models)
     structure = models[0].structure
@@ -232,27 +178,27 @@ def _trajectory_metrics(
         at = rows[lo:hi]
         results["feasible"][at] = valid.all(axis=1)
         raw = found["conditioning"].reshape(k, S)
-        results["min_conditioning"][at] = _least(np.where(np.isfinite(raw), raw, np.inf))
+        results["min_conditioning"][at] = least(np.where(np.isfinite(raw), raw, np.inf))
         w = np.where(ok, weight, 0.0)
         total = w.sum(axis=1)
         for leg in LEGS:
             tau = get(f"{effort}_{leg}")
-            results[f"peak_tau_{leg}"][at] = _peak(tau)
+            results[f"peak_tau_{leg}"][at] = peak(tau)
             with np.errstate(invalid="ignore", divide="ignore", over="ignore"):  # inf: too large
                 power = np.where(ok, tau, 0.0) ** 2
                 results[f"rms_tau_{leg}"][at] = np.sqrt((power * w).sum(axis=1) / total)
         if structure.paper:
             for family in JOINT_FAMILIES:
                 loads = np.concatenate([get(f"{family}_{leg}") for leg in LEGS], axis=1)
-                results[f"peak_{family}"][at] = _peak(loads)
+                results[f"peak_{family}"][at] = peak(loads)
         else:
             for j in (1, 2, 3):
                 forces = np.concatenate(
                     [np.hypot(get(f"fx{j}_{leg}"), get(f"fy{j}_{leg}")) for leg in LEGS], axis=1
                 )
-                results[f"peak_f{j}"][at] = _peak(forces)
+                results[f"peak_f{j}"][at] = peak(forces)
                 moments = np.concatenate([get(f"m{j}_{leg}") for leg in LEGS], axis=1)
-                results[f"peak_m{j}"][at] = _peak(moments)
+                results[f"peak_m{j}"][at] = peak(moments)
         for j in map(int, np.flatnonzero(~valid.all(axis=1))):
             model = models[lo + j]
             bounded = {f"{f}_{leg}": values[j][:, i] for i, (leg, f, _, _) in enumerate(limits)}
@@ -266,17 +212,6 @@ def _blanked(values: dict[str, np.ndarray], ok: np.ndarray) -> Callable[[str], n
         return np.where(ok, values[name].reshape(ok.shape), np.nan)
 
     return get
-
-
-def _peak(values: np.ndarray) -> np.ndarray:
-    """Per row, the largest ``|value|`` of the finite ones; NaN when none is."""
-    peak = np.where(np.isfinite(values), np.abs(values), -np.inf).max(axis=1)
-    return np.where(np.isfinite(peak), peak, np.nan)
-
-
-def _least(values: np.ndarray) -> np.ndarray:
-    least = values.min(axis=1)
-    return np.where(np.isfinite(least), least, np.nan)
 
 
 def _reason(

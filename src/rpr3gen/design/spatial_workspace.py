@@ -28,6 +28,8 @@ __all__ = ["SpatialWorkspace", "spatial_workspace", "write_spatial_workspace"]
 
 DEFAULT_RESOLUTION = 41
 DEFAULT_HEIGHTS = 9
+#: A leg's ``reach`` at or below this: it cannot hold the pose (the generated code's floor).
+MIN_REACH = 1e-9
 
 
 @dataclass(frozen=True)
@@ -67,6 +69,44 @@ def _size(model: Model) -> float:
     )
 
 
+def workspace_box(
+    model: Model, resolution: int, heights: int, orientation: tuple[float, ...]
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The grid of :func:`spatial_workspace`: its axes ``x``, ``y``, ``z`` and every pose
+    ``q`` on it, (heights * resolution^2, dof), ``z`` slowest and ``x`` fastest; a hexapod's at
+    the ``orientation`` ``(a, b, c)`` (rad)."""
+    half = _size(model)
+    x = np.linspace(-half, half, resolution)
+    y = np.linspace(-half, half, resolution)
+    z = np.linspace(-half, half, heights) if heights > 1 else np.zeros(1)
+    Z, Y, X = np.meshgrid(z, y, x, indexing="ij")
+    q = np.column_stack([X.ravel(), Y.ravel(), Z.ravel()])
+    if model.structure.dof == 6:
+        q = np.column_stack([q, np.tile(orientation, (len(q), 1))])
+    return x, y, z, q
+
+
+def reachable_poses(
+    diagnostics: np.ndarray, min_conditioning: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """From ``pose_diagnostics``' output (n, legs + 1): which poses are reachable (every leg
+    reaches the pose, its reach above ``MIN_REACH``, and the conditioning is at least
+    ``min_conditioning``), and the conditioning (NaN where a leg does not reach the pose)."""
+    reach = diagnostics[:, :-1]
+    conditioning = diagnostics[:, -1].copy()
+    with np.errstate(invalid="ignore"):
+        ok = np.isfinite(reach).all(axis=1) & (reach.min(axis=1) > MIN_REACH)
+    conditioning[~ok] = np.nan
+    with np.errstate(invalid="ignore"):
+        reachable = ok & (conditioning >= min_conditioning)
+    return reachable, conditioning
+
+
+def cell_volume(x: np.ndarray, y: np.ndarray, z: np.ndarray) -> float:
+    """The volume of one cell of the grid ``x, y, z`` (m^3; one slice: its area, m^2)."""
+    return float((x[1] - x[0]) * (y[1] - y[0]) * ((z[1] - z[0]) if len(z) > 1 else 1.0))
+
+
 @checked(
     resolution=Integer(2, cost=lambda n: n * n * 64 * 8, what="the workspace's points"),
     heights=Integer(1, cost=lambda n: n * 64 * 8, what="the workspace's slices"),
@@ -96,28 +136,15 @@ def spatial_workspace(
     angles = tuple(float(v) for v in orientation)
     if len(angles) != 3 or not all(math.isfinite(v) for v in angles):
         raise InputError(f"orientation: must be three finite angles (rad), got {orientation!r}")
-    half = _size(model)
-    x = np.linspace(-half, half, resolution)
-    y = np.linspace(-half, half, resolution)
-    z = np.linspace(-half, half, heights) if heights > 1 else np.zeros(1)
-    Z, Y, X = np.meshgrid(z, y, x, indexing="ij")
-    q = np.column_stack([X.ravel(), Y.ravel(), Z.ravel()])
-    if s.dof == 6:
-        q = np.column_stack([q, np.tile(angles, (len(q), 1))])
+    x, y, z, q = workspace_box(model, resolution, heights, angles)
     (diagnostics,), _ = evaluate(model, "pose_diagnostics", (q,))
-    reach = diagnostics[:, :-1]
-    conditioning = diagnostics[:, -1].copy()
-    with np.errstate(invalid="ignore"):
-        ok = np.isfinite(reach).all(axis=1) & (reach.min(axis=1) > 1e-9)
-    conditioning[~ok] = np.nan
-    with np.errstate(invalid="ignore"):
-        reachable = ok & (conditioning >= min_conditioning)
+    reachable, conditioning = reachable_poses(diagnostics, min_conditioning)
     tau = np.full((len(q), len(s.legs)), np.nan)
     if reachable.any():
         rest = np.zeros((int(reachable.sum()), s.dof))
         out = inverse_dynamics(model, q[reachable], rest, rest)
         tau[reachable] = np.column_stack([out[f"tau_{leg}"] for leg in s.legs])
-    cell = (x[1] - x[0]) * (y[1] - y[0]) * ((z[1] - z[0]) if heights > 1 else 1.0)
+    cell = cell_volume(x, y, z)
     shape = (len(z), len(y), len(x))
     return SpatialWorkspace(
         model=model,

@@ -23,7 +23,13 @@ from rpr3gen.validation import (
     describe,
 )
 
-__all__ = ["ARGUMENTS", "check_memory", "check_paper_samples", "check_values"]
+__all__ = [
+    "ARGUMENTS",
+    "SPATIAL_STACKED_SAMPLE",
+    "check_memory",
+    "check_paper_samples",
+    "check_values",
+]
 
 
 class _FileOrTables(Check):
@@ -70,11 +76,23 @@ ARGUMENTS: dict[str, Check] = {
     "resume": Flag(),
     "chunk_size": Integer(1),
     "area_resolution": Integer(0),
+    "volume_resolution": Integer(
+        0,
+        cost=lambda n: n**3 * sizes.STACKED_SAMPLE,
+        what="each design's workspace volume",
+    ),
     "samples": Integer(2),
     "duration": Number(least=DURATIONS[0], most=DURATIONS[1], unit="s"),
 }
 """The check of each argument of :func:`rpr3gen.sweep` (with :data:`rpr3gen.validation.COMMON`'s
-``min_conditioning`` and ``progress``)."""
+``min_conditioning``, ``backend`` and ``progress``)."""
+
+#: A design x sample (or pose of its volume) of a spatial sweep's stacked evaluation: its
+#: parameter column (about 100 values for a Delta, 210 for a hexapod), its inputs, its outputs
+#: and the generated code's temporaries (bytes). Measured (tracemalloc's peak of a chunk of 64
+#: designs): 5.0 KiB a sample of the Delta's trajectory, 7.1 KiB of the 6-UPS's, and 1.6 and 2.6
+#: KiB a pose of their volumes; rounded up.
+SPATIAL_STACKED_SAMPLE = 8 * sizes.KIB
 
 
 def check_values(
@@ -84,27 +102,42 @@ def check_values(
     samples: Any,
     duration: Any,
     min_conditioning: Any,
+    volume_resolution: Any = 0,
+    backend: Any = "numpy",
 ) -> None:
     """The values a plan is made of (for callers of ``make_plan`` that skipped ``sweep``'s
-    checks), and ``area_resolution`` 0 (no area) or at least 2."""
+    checks), and ``area_resolution`` and ``volume_resolution`` 0 (none) or at least 2."""
     if grid is None:
         raise InputTypeError(
             "grid: give a grid file or a mapping {dotted model key: values}", argument="grid"
         )
     given = {"chunk_size": chunk_size, "area_resolution": area_resolution, "samples": samples,
-             "duration": duration}  # fmt: skip
+             "duration": duration, "volume_resolution": volume_resolution}  # fmt: skip
     for name, value in given.items():
         ARGUMENTS[name](name, value)
     COMMON["min_conditioning"]("min_conditioning", min_conditioning)
-    if area_resolution == 1:
-        raise InputError(
-            "area_resolution: must be 0 (no area) or an integer >= 2, got 1",
-            argument="area_resolution",
-        )
+    COMMON["backend"]("backend", backend)
+    for name, what in (("area_resolution", "area"), ("volume_resolution", "volume")):
+        if given[name] == 1:
+            raise InputError(
+                f"{name}: must be 0 (no {what}) or an integer >= 2, got 1", argument=name
+            )
 
 
-def _cost(designs: int, chunk: int, samples: int, area: int, processes: int) -> int:
-    return sizes.sweep_cost(designs, min(chunk, designs), samples, area, processes, BLOCK)
+def _cost(
+    designs: int,
+    chunk: int,
+    samples: int,
+    area: int,
+    processes: int,
+    volume: int = 0,
+    sample_bytes: int = sizes.STACKED_SAMPLE,
+) -> int:
+    """Bytes of a sweep (:func:`rpr3gen.sizes.sweep_cost`): a planar one's with its ``area``
+    resolution, a spatial one's with its ``volume`` resolution and ``sample_bytes``."""
+    points = volume**3 if volume else None
+    return sizes.sweep_cost(designs, min(chunk, designs), samples, area, processes, BLOCK,
+                            points=points, sample_bytes=sample_bytes)  # fmt: skip
 
 
 def check_paper_samples(samples: int, papers: int) -> None:
@@ -114,19 +147,36 @@ def check_paper_samples(samples: int, papers: int) -> None:
 
 
 def check_memory(
-    grid: Any, samples: int, chunk: int, area: int, processes: int, workers: int | None
+    grid: Any,
+    samples: int,
+    chunk: int,
+    area: int,
+    processes: int,
+    workers: int | None,
+    volume: int = 0,
+    sample_bytes: int = sizes.STACKED_SAMPLE,
 ) -> None:
     """The sweep's sizes against the memory limit, each with those before it as given and those
-    after it at their least: the area's resolution, the number of designs, the worker processes
-    (``processes`` running tasks on this machine; ``workers`` the argument that set them)."""
-    sizes.check("area_resolution", area, lambda a: _cost(1, 1, samples, a, 1),
-                "each design's workspace area", argument="area_resolution")  # fmt: skip
-    sizes.check(grid.source, len(grid), lambda d: _cost(d, chunk, samples, area, 1),
+    after it at their least: the area's (or a spatial sweep's volume's) resolution, the number
+    of designs, the worker processes (``processes`` running tasks on this machine; ``workers``
+    the argument that set them). A spatial sweep gives ``area`` 0, its ``volume`` resolution
+    and its ``sample_bytes`` (:data:`SPATIAL_STACKED_SAMPLE`)."""
+
+    def cost(designs: int, chunk: int, area: int, processes: int, volume: int) -> int:
+        return _cost(designs, chunk, samples, area, processes, volume, sample_bytes)
+
+    if volume:
+        sizes.check("volume_resolution", volume, lambda v: cost(1, 1, 0, 1, v),
+                    "each design's workspace volume", argument="volume_resolution")  # fmt: skip
+    else:
+        sizes.check("area_resolution", area, lambda a: cost(1, 1, a, 1, 0),
+                    "each design's workspace area", argument="area_resolution")  # fmt: skip
+    sizes.check(grid.source, len(grid), lambda d: cost(d, chunk, area, 1, volume),
                 "the sweep's results and tasks", least=1, unit="designs",
                 error=GridError)  # fmt: skip
     if processes > 1:
         designs = len(grid)
         sizes.check("workers" if workers else "workers (one per core)", processes,
-                    lambda w: _cost(designs, chunk, samples, area, w),
+                    lambda w: cost(designs, chunk, area, w, volume),
                     "the local cluster's processes and their tasks", least=1,
                     argument="workers")  # fmt: skip

@@ -19,7 +19,7 @@ import numpy as np
 
 from rpr3gen.errors import InputTypeError, ModelError, did_you_mean
 from rpr3gen.loader import check_folder
-from rpr3gen.structure import LEGS, Structure
+from rpr3gen.structure import Structure
 from rpr3gen.validation import PathArg, describe
 
 __all__ = ["check_fields"]
@@ -59,8 +59,6 @@ def check_fields(model: Any, actuations: Sequence[str]) -> dict:
     hint = "; structure=None means the paper's format" if model.structure is None else ""
     params = _params(model.params, source, param_names, hint)
     stroke = None if model.stroke is None else _stroke(model.stroke, source)
-    if model.limits is not None and structure.spatial:
-        raise ModelError(f"{source}: limits: joint limits are not supported for spatial models yet")
     limits = None if model.limits is None else _limits(model.limits, source, structure)
     generated = None
     if model.generated is not None:
@@ -136,13 +134,13 @@ def _limits(limits: Any, source: str, structure: Structure) -> dict[str, tuple[f
         raise ModelError(
             f"{source}: limits: the paper's format bounds its pistons with stroke, not limits"
         )
-    names = [f"{leg}.q{j}" for leg in LEGS for j in (1, 2, 3)]
+    names = [f"{leg}.{q}" for leg in structure.legs for q in structure.limited_coordinates()]
     out = {}
     for key, pair in limits.items():
         if key not in names:
             hint = did_you_mean(str(key), names)
             raise ModelError(f"{source}: limits[{key!r}]: unknown joint coordinate{hint} "
-                             '("A.q1" to "C.q3")')  # fmt: skip
+                             f'("{names[0]}" to "{names[-1]}")')  # fmt: skip
         where = f"{source}: limits[{key!r}]"
         if isinstance(pair, str) or not isinstance(pair, Sequence | np.ndarray) or len(pair) != 2:
             raise ModelError(f"{where}: must be a pair (lo, hi), got {describe(pair)}")

@@ -143,7 +143,9 @@ class GeneralReader(Reader):
         )
         params["fx"], params["fy"] = self.vector(payload, "payload.force", "force", 2, (0.0, 0.0))
         params["mz"] = self.number(payload, "payload.moment", "moment", default=0.0)
-        limits = self.limits(data.get("limits", {}), structure)
+        limits = self.joint_limits(
+            data.get("limits", {}), LEGS, structure.limited_coordinates(), structure.leg
+        )
         return Model(
             name=name,
             actuation=structure.actuation,
@@ -314,31 +316,6 @@ class GeneralReader(Reader):
                 f"conditioning {conditioning:.3g}); the platform could move with the motors "
                 "locked",
             )
-
-    def limits(self, table: Any, structure: Structure) -> dict[str, tuple[float, float]] | None:
-        if not table:
-            return None
-        if not isinstance(table, Mapping):
-            self.fail("limits", f"must be a table [limits], got {describe(table)}")
-        names = [f"{leg}.q{j}" for leg in LEGS for j in (1, 2, 3)] + [f"q{j}" for j in (1, 2, 3)]
-        out: dict[str, tuple[float, float]] = {}
-        for key in table:
-            if key not in names:
-                hint = did_you_mean(str(key), names)
-                self.fail(
-                    f"limits.{key}",
-                    f'unknown key{hint} (a joint coordinate: "A.q2", or "q2" for every leg)',
-                )
-            lo, hi = self.vector(table, f"limits.{key}", key, 2)
-            if not lo < hi:
-                self.fail(
-                    f"limits.{key}",
-                    f"the lower bound must be below the upper, got [{lo:g}, {hi:g}]",
-                )
-            legs = (key.split(".")[0],) if "." in key else LEGS
-            for leg in legs:
-                out[f"{leg}.{key.split('.')[-1]}"] = (lo, hi)
-        return dict(sorted(out.items()))
 
 
 def _unit_scaled(

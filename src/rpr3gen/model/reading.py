@@ -107,6 +107,36 @@ class Reader:
             self.fail(dotted, f"must be {kind}, got {describe(value)}")
         return x
 
+    def joint_limits(
+        self, table: Any, legs: Sequence[str], coordinates: Sequence[str], leg_type: str
+    ) -> dict[str, tuple[float, float]] | None:
+        """``[limits]``: ``"A.q2" = [lo, hi]`` (m or rad) bounds one leg's joint coordinate,
+        ``"q2"`` every leg's; ``coordinates`` are those a ``leg_type`` leg may bound."""
+        if not table:
+            return None
+        if not isinstance(table, Mapping):
+            self.fail("limits", f"must be a table [limits], got {describe(table)}")
+        names = [f"{leg}.{q}" for leg in legs for q in coordinates] + list(coordinates)
+        out: dict[str, tuple[float, float]] = {}
+        for key in table:
+            if key not in names:
+                hint = did_you_mean(str(key), names)
+                self.fail(
+                    f"limits.{key}",
+                    f"unknown key{hint} (a joint coordinate of this {leg_type} leg: "
+                    f'{", ".join(repr(c) for c in coordinates)}, as "A.{coordinates[-1]}" for '
+                    "one leg or alone for every leg)",
+                )
+            lo, hi = self.vector(table, f"limits.{key}", key, 2)
+            if not lo < hi:
+                self.fail(
+                    f"limits.{key}",
+                    f"the lower bound must be below the upper, got [{lo:g}, {hi:g}]",
+                )
+            for leg in (key.split(".")[0],) if "." in key else legs:
+                out[f"{leg}.{key.split('.')[-1]}"] = (lo, hi)
+        return dict(sorted(out.items()))
+
     def vector(
         self,
         table: Mapping[str, Any],

@@ -82,7 +82,7 @@ SCHEMA: dict[str, Any] = {
     "platform": {"mass": None, "com": None, "inertia": None},
     "environment": {"gravity": None},
     "payload": {"force": None, "moment": None},
-    "limits": None,  # refused: not supported for spatial models yet
+    "limits": None,  # keys "A.q2" or "q2": checked by the reader
 }
 _MOTOR = {"UPS": "the P", "RUS": "the R", "PUS": "the P", "RSS2": "the R", "PSS2": "the P"}
 _BODIES = {"UPS": "cylinder, piston", "RUS": "crank, rod", "PUS": "carriage, rod",
@@ -116,8 +116,6 @@ class SpatialReader(Reader):
         if not isinstance(data, Mapping):
             raise ModelError(f"{self.source}: a model must be a table, got {describe(data)}")
         self.check_keys(data, SCHEMA, "")
-        if "limits" in data:
-            self.fail("limits", "joint limits are not supported for spatial models yet")
         name = self.required(data, "name", "name")
         if not isinstance(name, str) or not name.strip():
             self.fail("name", f"must be a non-empty string, got {describe(name)}")
@@ -152,6 +150,12 @@ class SpatialReader(Reader):
             params=params,
             source=self.source,
             structure=structure,
+            limits=self.joint_limits(
+                data.get("limits", {}),
+                structure.legs,
+                structure.limited_coordinates(),
+                structure.leg,
+            ),
         )
 
     def structure(self, data: Mapping[str, Any]) -> Structure:
