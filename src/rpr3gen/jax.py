@@ -5,7 +5,7 @@ calls.
 >>> import jax, rpr3gen, rpr3gen.jax as rj
 >>> model = rpr3gen.load_model()
 >>> g = rj.function(model, "inverse_dynamics")      # g(params, q, qd, qdd) -> out
->>> out = jax.jit(g)(rj.parameters(model), q, qd, qdd)
+>>> out = jax.jit(g, compiler_options=rj.COMPILER_OPTIONS)(rj.parameters(model), q, qd, qdd)
 >>> dtau_dq = jax.jacfwd(g, argnums=1)(rj.parameters(model), q, qd, qdd)
 
 The functions take one sample (``jax.vmap`` maps them over many) and return the public outputs
@@ -32,9 +32,9 @@ __all__ = ["COMPILER_OPTIONS", "JaxEvaluator", "function", "parameters"]
 #: XLA's options for compiling a bridge function: without its "fusion" pass. XLA's CPU
 #: instruction fusion is superlinear on long straight-line programs of scalars (the hexapod's
 #: inverse dynamics, ~10^4 operations, did not compile in five minutes; without the pass: 8 s,
-#: the Delta's in 2 s instead of 10). ``function`` returns functions jitted with them; a caller
-#: that jits a larger function around one passes them too: ``jax.jit(f,
-#: compiler_options=rpr3gen.jax.COMPILER_OPTIONS)``.
+#: the Delta's in 2 s instead of 10). ``backend="jax"`` compiles with them; a caller that jits a
+#: function of its own passes them to its outermost ``jax.jit`` (XLA takes options there only):
+#: ``jax.jit(f, compiler_options=rpr3gen.jax.COMPILER_OPTIONS)``.
 COMPILER_OPTIONS: dict[str, str] = {"xla_disable_hlo_passes": "fusion"}
 
 
@@ -141,9 +141,10 @@ def function(model: Model, name: str) -> Callable[..., Any]:
 
     Returns:
         ``g(params, *inputs)``, arguments as the C ABI (float64 arrays (P,), (k,) ...), giving
-        the public outputs (one array, or a tuple of them); jitted already, with
-        :data:`COMPILER_OPTIONS`, and ``jax.jit``, ``jax.vmap``, ``jax.grad`` and
-        ``jax.jacfwd`` accept it. No refusal applies: at a singular pose it
+        the public outputs (one array, or a tuple of them); ``jax.jit``, ``jax.vmap``,
+        ``jax.grad`` and ``jax.jacfwd`` accept it. Jit the outermost function with
+        :data:`COMPILER_OPTIONS` (a hexapod's inverse dynamics compiles in seconds with them,
+        in many minutes without). No refusal applies: at a singular pose it
         gives what the formulas give (docs/bridges.md, "Refusals").
 
     Raises:
@@ -169,7 +170,7 @@ def function(model: Model, name: str) -> Callable[..., Any]:
 
     g.__name__ = g.__qualname__ = name
     g.__doc__ = f"{info.doc}\n\nArguments: params, {', '.join(a.name for a in info.inputs)}."
-    return _jax().jit(g, compiler_options=COMPILER_OPTIONS)
+    return g
 
 
 @checked()
