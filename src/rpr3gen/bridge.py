@@ -12,13 +12,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 from types import ModuleType
 
-from rpr3gen import graph_compose, variants
+from rpr3gen import graph_compose
 from rpr3gen.errors import InputError, Rpr3genError, did_you_mean
 from rpr3gen.loader import graph_module
 from rpr3gen.manifest import FunctionInfo, Variant
-from rpr3gen.model import Model
 
-__all__ = ["Target", "missing_extra", "names", "target", "variant"]
+__all__ = ["Target", "missing_extra", "names", "target"]
 
 
 @dataclass(frozen=True)
@@ -33,11 +32,6 @@ class Target:
 def names(variant: Variant) -> tuple[str, ...]:
     """The functions of ``variant`` the bridges offer, in the manifest's order."""
     return tuple(n for n, f in variant.functions.items() if graph_compose.offered(variant, f))
-
-
-def variant(model: Model) -> Variant:
-    """``model``'s generated variant (derived on first use, as for the other backends)."""
-    return variants.load(model.structure, model.generated)
 
 
 def target(variant: Variant, name: str) -> Target:

@@ -17,17 +17,14 @@ CasADi is imported on the first call, not with :mod:`rpr3gen`.
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
-from rpr3gen import bridge, graph_compose
+from rpr3gen import bridge, graph_compose, variants
 from rpr3gen.manifest import Variant
 from rpr3gen.model import Model
 from rpr3gen.validation import Instance, checked
-
-if TYPE_CHECKING:
-    import casadi
 
 __all__ = ["function", "parameters"]
 
@@ -123,7 +120,7 @@ def _build(variant: Variant, name: str) -> Any:
 
 
 @checked(name=Instance(str, "the name of a generated function"))
-def function(model: Model, name: str) -> casadi.Function:
+def function(model: Model, name: str) -> Any:
     """The function ``name`` of ``model``'s variant as a ``casadi.Function`` of SX graphs.
 
     Args:
@@ -143,7 +140,7 @@ def function(model: Model, name: str) -> casadi.Function:
         InputTypeError: ``model`` is not a :class:`rpr3gen.Model`, or ``name`` not a string.
         Rpr3genError: CasADi is not installed (``pip install 'rpr3gen[casadi]'``).
     """
-    return _function(bridge.variant(model), name)
+    return _function(variants.load(model.structure, model.generated), name)
 
 
 @checked()
@@ -151,4 +148,4 @@ def parameters(model: Model) -> np.ndarray:
     """The ``params`` input of ``model``'s functions: its numbers in the variant's order
     (float64 (P,), the C ABI's ``params`` array; ``casadi.DM(parameters(model))`` if a DM is
     wanted)."""
-    return model.vector(bridge.variant(model).param_names)
+    return model.vector(variants.load(model.structure, model.generated).param_names)

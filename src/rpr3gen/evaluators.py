@@ -3,7 +3,7 @@
 An :class:`Evaluator` evaluates any function of a generated variant's manifest over a block of
 samples (:meth:`~Evaluator.run`) into output arrays it allocates in its own layout
 (:meth:`~Evaluator.allocate`; always seen as (n, size)). ``numpy`` runs the generated NumPy
-module; ``jax`` its graph module through JAX (:class:`rpr3gen.jax.JaxEvaluator`, the extra
+module; ``jax`` its graph module through JAX (:class:`rpr3gen.jax_graph.JaxEvaluator`, the extra
 ``jax``); ``c`` the generated C, compiled and bound by :mod:`rpr3gen.cbackend`, on every core:
 its batch functions are re-entrant and ctypes releases the GIL while they run, so contiguous
 chunks of a block run on a pool of threads (:data:`threads`). Neither knows any function in
@@ -262,7 +262,7 @@ def evaluator(variant: Variant, backend: str) -> Evaluator:
     elif backend == "c":
         made = CEvaluator(variant)
     elif backend == "jax":
-        from rpr3gen.jax import JaxEvaluator  # imports JAX on first use (the extra "jax")
+        from rpr3gen.jax_graph import JaxEvaluator  # imports JAX on first use (the extra "jax")
 
         made = JaxEvaluator(variant)
     else:
