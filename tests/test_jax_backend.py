@@ -18,6 +18,7 @@ import pytest
 
 import rpr3gen
 import rpr3gen.jax as rj
+from rpr3gen import bridge
 
 try:
     from . import bridge_cases as bc
@@ -155,3 +156,27 @@ def test_missing_jax_names_the_extra(monkeypatch: pytest.MonkeyPatch) -> None:
 def test_float64_is_on() -> None:
     rj.function(rpr3gen.load_model(), "actuator_coordinates")
     assert jax.config.read("jax_enable_x64")
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", ["rrr_1", "rss2_1"])
+def test_every_function_equals_the_numpy_backend(name: str) -> None:
+    """Every function the bridges offer, as a pure function mapped over the samples, run op by
+    op (``jax.disable_jit``: the values are the compiled ones, within round-off, without
+    compiling each function; a spatial robot's graph functions are the CasADi test's, its
+    compositions, which map calls with ``vmap`` and solve with JAX's, are tested here)."""
+    c = bc.case(name)
+    variant = rpr3gen.manifest.load(c.model.structure.variant)
+    params = rj.parameters(c.model)
+    for function in bridge.names(variant):
+        if c.model.structure.spatial and variant.function(function).numpy_function:
+            continue
+        info = variant.function(function)
+        inputs = bc.inputs(c, info)
+        g = rj.function(c.model, function)
+        with jax.disable_jit():
+            found = jax.vmap(g, in_axes=(None,) + (0,) * len(inputs))(params, *inputs)
+        found = found if isinstance(found, tuple) else (found,)
+        tolerance = 1e-10 if function.startswith("forward_kinematics") else RTOL
+        for got, want in zip(found, bc.expected(c, function, inputs), strict=True):
+            bc.scale_close(np.asarray(got), want, tolerance)
