@@ -10,8 +10,9 @@ The tracked forward kinematics (planar and spatial) is :data:`NEWTON_STEPS` plai
 from ``q_near`` on the generated ``actuator_coordinates_jacobian``: no step halving, no
 fallback to another assembly mode.
 
-Values are lists of scalars of the caller's kind; ``ops`` is the graph module's namespace
-(:data:`rpr3gen_generated`'s ``sin``, ``cos``, ...) plus :class:`Ops`'s three array helpers.
+Values are lists of scalars of the caller's kind; ``ops`` is the namespace the generated graph
+functions call (``sin``, ``cos``, ``atan2``, ...: docs/bridges.md) with :class:`Ops`'s three
+array helpers, and optionally ``batch`` (several calls of one generated function at once).
 Nothing here refuses a sample: :class:`Result` carries the values the refusals test (the inner
 functions' ``below`` checks, the Newton residual), which the JAX backend applies and a CasADi
 graph cannot.
