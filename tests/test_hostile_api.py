@@ -58,6 +58,8 @@ from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
 
 import rpr3gen
+import rpr3gen.casadi
+import rpr3gen.jax
 from rpr3gen.errors import (
     GridError,
     IdentificationError,
@@ -255,11 +257,17 @@ MOTION = rows(3)
 def _backend(value: Any) -> str | None:
     if not isinstance(value, str):
         return "type"
-    return {"numpy": "ok", "c": None}.get(value, "value")  # "c" compiles: other tests do
+    # "c" compiles, "jax" compiles each function (the extra "jax"): other tests do
+    return {"numpy": "ok", "c": None, "jax": None}.get(value, "value")
+
+
+def _c_backend(value: Any) -> str | None:
+    return "ok" if value == "c" else _backend(value)
 
 
 BACKEND = dataclasses.replace(choice("numpy"), classify=_backend)
-C_BACKEND = choice("numpy", "c")  # a scene of the C backend: its library is built already
+# a scene of the C backend: its library is built already
+C_BACKEND = dataclasses.replace(choice("numpy", "c"), classify=_c_backend)
 THREADS = optional(count(1, 4))
 CONDITIONING = number(least=0.0, below=1.0, good=(0.0, 0.5))
 FUNCTIONS = tuple(sorted(rpr3gen.manifest.load("revolute").functions))  # every variant's
@@ -280,6 +288,24 @@ def _function(s: Scene) -> Kind:
         wrong_types=(None, 5, ["inverse_dynamics"]),
         bad_values=("nothing", "", "inverse-dynamics"),
         good_values=MOTION_FUNCTIONS,
+    )
+
+
+def _bridge_name(s: Scene) -> Kind:
+    """The bridges' ``name``: a function of the scene's variant (a planar robot's are all
+    offered; the inverse dynamics is the one built here)."""
+
+    def classify(value: Any) -> str | None:
+        if not isinstance(value, str):
+            return "type"
+        return "ok" if value == "inverse_dynamics" else None if value in s.functions else "value"
+
+    return Kind(
+        "name",
+        classify,
+        wrong_types=(None, 5, ["inverse_dynamics"]),
+        bad_values=("nothing", "", "inverse-dynamics"),
+        good_values=("inverse_dynamics",),
     )
 
 
@@ -1070,6 +1096,20 @@ def apis(s: Scene) -> tuple[Api, ...]:
                 "min_conditioning": number(least=0.0, below=1.0, good=(0.0, 1e-3)),
                 "backend": backend,
             },
+        ),
+        *(
+            _api(
+                f"{bridge}.{what}",
+                call=getattr(module, what),
+                good=(lambda tmp: {"model": model, "name": "inverse_dynamics"})
+                if what == "function"
+                else (lambda tmp: {"model": model}),
+                kinds={"model": model_kind, "name": _bridge_name(s)}
+                if what == "function"
+                else {"model": model_kind},
+            )
+            for bridge, module in (("casadi", rpr3gen.casadi), ("jax", rpr3gen.jax))
+            for what in ("function", "parameters")
         ),
         _api(
             "Fit.predict",

@@ -26,7 +26,7 @@ OWN = {"rpr3gen", "rpr3gen_generated", "rpr3gen_derive"}
 #: The extras whose modules the runtime may import, each only where an ImportError is caught
 #: (``video``: imageio-ffmpeg's ffmpeg for MP4 movies, rpr3gen.animation; ``toppra``: TOPP-RA for
 #: rpr3gen.retime, rpr3gen.retiming.topp).
-RUNTIME_EXTRAS = ("video", "toppra")
+RUNTIME_EXTRAS = ("video", "toppra", "casadi", "jax")
 
 #: Run in the fresh venv: every requirement the installed wheel declares is met, by version.
 _REQUIREMENTS_MET = """

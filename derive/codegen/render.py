@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import Any
 
 import jinja2
-from rpr3gen_derive.codegen.backends import c, python
+from rpr3gen_derive.codegen.backends import c, graph, python
 from rpr3gen_derive.codegen.backends.c import comment
 from rpr3gen_derive.codegen.compiled import Stage, compile_function, no_stage
 from rpr3gen_derive.codegen.files import source_hash
@@ -142,7 +142,7 @@ class Generator:
             compiled = [compile_function(f, module.params) for f in module.functions]
         files: dict[str, str] = {}
         roles: dict[str, str] = {}
-        for backend in (python, c):
+        for backend in (python, c, graph):
             for role, (name, text) in backend.render(
                 module, compiled, digest, self.env, self.stage
             ).items():

@@ -10,7 +10,6 @@ planar variants' (docs/interfaces.md), with ``q`` of 6 or 3 components.
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
-from functools import cache
 
 import sympy as sp
 from rpr3gen_derive.codegen import derivatives
@@ -25,9 +24,18 @@ from rpr3gen_derive.codegen.spec import (
     ReturnCode,
     Threshold,
 )
-from rpr3gen_derive.spatial import identification, virtual_work
-from rpr3gen_derive.spatial.platform import param, pose_symbols
-from rpr3gen_derive.spatial.structures import SpatialStructure, param_doc, param_names
+from rpr3gen_derive.spatial import virtual_work
+from rpr3gen_derive.spatial.arguments import (
+    c_context,
+    checks,
+    derivation,
+    efforts,
+    params_argument,
+    pose_arguments,
+    unit,
+)
+from rpr3gen_derive.spatial.regressor import inertial_parameters, regressor
+from rpr3gen_derive.spatial.structures import SpatialStructure, param_names
 
 PREFIX = "rpr3"
 
@@ -60,98 +68,10 @@ THRESHOLDS: tuple[Threshold, ...] = (
     ),
 )
 
-_UNITS = {"x": "m", "y": "m", "z": "m", "a": "rad", "b": "rad", "c": "rad"}
-_MEANINGS = {
-    "x": "platform origin, world x",
-    "y": "platform origin, world y",
-    "z": "platform origin, world z",
-    "a": "platform orientation R = Rz(c) Ry(b) Rx(a): angle about x",
-    "b": "platform orientation: angle about y",
-    "c": "platform orientation: angle about z",
-}
-
-
-def pose_arguments(structure: SpatialStructure) -> tuple[Argument, Argument, Argument]:
-    """``q``, ``qd``, ``qdd``: the pose (docs/spatial-robots.md), its rates and accelerations."""
-    q, qd, qdd = pose_symbols(structure)
-    names = structure.pose
-    return (
-        Argument(
-            "q",
-            q,
-            tuple(Component(n, _UNITS[n], _MEANINGS[n]) for n in names),
-            "platform pose: origin (m)" + (", angles (rad)" if structure.dof == 6 else ""),
-        ),
-        Argument(
-            "qd",
-            qd,
-            tuple(Component(f"d{n}", f"{_UNITS[n]}/s", f"d({n})/dt") for n in names),
-            "its time derivative",
-        ),
-        Argument(
-            "qdd",
-            qdd,
-            tuple(Component(f"dd{n}", f"{_UNITS[n]}/s^2", f"d2({n})/dt2") for n in names),
-            "its second time derivative",
-        ),
-    )
-
-
-def params_argument(structure: SpatialStructure) -> Argument:
-    names = param_names(structure)
-    return Argument(
-        name="params",
-        symbols=tuple(param(n) for n in names),
-        components=tuple(Component(n, *param_doc(n)) for n in names),
-        doc="model parameters",
-        table="param_names",
-    )
-
-
-@cache
-def _derivation(structure: SpatialStructure) -> virtual_work.InverseDynamics:
-    return virtual_work.derive(structure)
-
-
-def _checks(derivation: virtual_work.InverseDynamics) -> tuple[Check, ...]:
-    return (
-        Check("inputs_not_finite", "NOT_FINITE"),
-        Check(
-            "below", "SINGULAR", threshold="MIN_REACH", guard=("reach", sp.Min(*derivation.reaches))
-        ),
-        Check(
-            "below",
-            "SINGULAR",
-            threshold="MIN_CONDITIONING",
-            guard=("conditioning", derivation.outputs["conditioning"]),
-        ),
-        Check("outputs_not_finite", "SINGULAR"),
-    )
-
-
-def _unit(name: str, structure: SpatialStructure) -> tuple[str, str]:
-    family, _, leg = name.rpartition("_")
-    if name == "conditioning":
-        return "1", "closeness to a parallel singularity: 1 at best, 0 singular"
-    head = family.rstrip("0123456789xyzab")
-    joint = "".join(ch for ch in family if ch.isdigit())
-    where = f"leg {leg}, joint {joint}"
-    if family == "tau":
-        unit = "N m" if structure.actuated_kind == "R" else "N"
-        return unit, f"actuator effort along its coordinate, leg {leg}"
-    if family[0] == "f":
-        return "N", f"force of the earlier body on the later, world {family[1]}, {where}"
-    if family[0] == "m":
-        return "N m", f"moment of the earlier body on the later about the joint, {where}"
-    kind = structure.kinds[int(joint) - 1] if not structure.delta or joint == "1" else "S"
-    unit = "m" if kind == "P" else "rad"
-    deriv = {"q": "", "qd": "/s", "qdd": "/s^2"}[head]
-    return unit + deriv, f"joint coordinate {family}, {where}"
-
 
 def inverse_dynamics(structure: SpatialStructure) -> FunctionSpec:
     """``rpr3_inverse_dynamics``: leg kinematics and every joint load of a spatial robot."""
-    d = _derivation(structure)
+    d = derivation(structure)
     return FunctionSpec(
         name="inverse_dynamics",
         doc=f"Inverse dynamics of the {structure.title}: every joint's coordinates and load "
@@ -163,19 +83,19 @@ def inverse_dynamics(structure: SpatialStructure) -> FunctionSpec:
             Output(
                 "out",
                 tuple(d.outputs.values()),
-                tuple(Component(n, *_unit(n, structure)) for n in d.outputs),
+                tuple(Component(n, *unit(n, structure)) for n in d.outputs),
                 "row k receives OUTPUT_NAMES[k]",
                 table="output_names",
             ),
         ),
         program=d.program,
-        checks=_checks(d),
+        checks=checks(d),
     )
 
 
 def actuator_coordinates(structure: SpatialStructure) -> FunctionSpec:
     """``rpr3_actuator_coordinates``: the actuated joints' coordinates of a pose."""
-    d = _derivation(structure)
+    d = derivation(structure)
     q = pose_arguments(structure)[0]
     unit = "rad" if structure.actuated_kind == "R" else "m"
     family = f"q{structure.actuated}"
@@ -193,13 +113,13 @@ def actuator_coordinates(structure: SpatialStructure) -> FunctionSpec:
             ),
         ),
         program=d.program,
-        checks=_checks(d),
+        checks=checks(d),
     )
 
 
 def pose_diagnostics(structure: SpatialStructure) -> FunctionSpec:
     """``rpr3_pose_diagnostics``: each leg's reach and the conditioning, with no check."""
-    d = _derivation(structure)
+    d = derivation(structure)
     q = pose_arguments(structure)[0]
     return FunctionSpec(
         name="pose_diagnostics",
@@ -256,7 +176,7 @@ def _qa_names(structure: SpatialStructure) -> list[str]:
 
 def actuator_jacobian(structure: SpatialStructure) -> FunctionSpec:
     """``rpr3_actuator_jacobian``: ``J = d qa / d q``, row-major (one row per leg)."""
-    d = _derivation(structure)
+    d = derivation(structure)
     return FunctionSpec(
         name="actuator_jacobian",
         doc="Actuator Jacobian J = d qa / d q, row-major, one row per leg: qa' = J q'. det J = 0 "
@@ -272,13 +192,13 @@ def actuator_jacobian(structure: SpatialStructure) -> FunctionSpec:
             ),
         ),
         program=d.program,
-        checks=_checks(d),
+        checks=checks(d),
     )
 
 
 def actuator_coordinates_jacobian(structure: SpatialStructure) -> FunctionSpec:
     """``rpr3_actuator_coordinates_jacobian``: ``qa`` and ``J`` in one call."""
-    d = _derivation(structure)
+    d = derivation(structure)
     return FunctionSpec(
         name="actuator_coordinates_jacobian",
         doc="Actuator coordinates qa of the pose q and the actuator Jacobian J = d qa / d q "
@@ -295,43 +215,13 @@ def actuator_coordinates_jacobian(structure: SpatialStructure) -> FunctionSpec:
             ),
         ),
         program=d.program,
-        checks=_checks(d),
+        checks=checks(d),
     )
-
-
-def _efforts(structure: SpatialStructure) -> Argument:
-    unit = "N m" if structure.actuated_kind == "R" else "N"
-    return Argument(
-        "tau",
-        tuple(sp.Symbol(f"tau_{leg}", real=True) for leg in structure.legs),
-        tuple(
-            Component(f"tau_{leg}", unit, f"actuator effort, leg {leg}") for leg in structure.legs
-        ),
-        "actuator efforts",
-    )
-
-
-def _c_context(structure: SpatialStructure, forward: bool = False) -> tuple:
-    d = _derivation(structure)
-    names = list(d.outputs)
-    params = param_names(structure)
-    return (
-        ("k", structure.dof),
-        ("outputs", len(names)),
-        ("tau", [names.index(f"tau_{leg}") for leg in structure.legs]),
-        ("loads", [params.index(n) for n in LOAD_PARAMS]),
-        ("params", len(params)),
-        ("forward", forward),
-    )
-
-
-#: The parameters of the loads that do not come from the motion: gravity and the payload.
-LOAD_PARAMS = ("gx", "gy", "gz", "fx", "fy", "fz", "mx", "my", "mz")
 
 
 def actuator_efforts(structure: SpatialStructure) -> FunctionSpec:
     """``rpr3_actuator_efforts``: the efforts alone of the inverse dynamics (C: its kernel)."""
-    tau = _efforts(structure)
+    tau = efforts(structure)
     return FunctionSpec(
         name="actuator_efforts",
         doc="Actuator efforts tau that produce the platform acceleration qdd at (q, qd): the "
@@ -346,7 +236,7 @@ def actuator_efforts(structure: SpatialStructure) -> FunctionSpec:
         program=Program(),
         checks=(Check("inputs_not_finite", "NOT_FINITE"), Check("custom", "SINGULAR")),
         c_body="spatial_efforts.c.jinja",
-        c_context=_c_context(structure),
+        c_context=c_context(structure),
     )
 
 
@@ -381,14 +271,14 @@ def task_space_dynamics(structure: SpatialStructure) -> FunctionSpec:
         program=Program(),
         checks=(Check("inputs_not_finite", "NOT_FINITE"), Check("custom", "SINGULAR")),
         c_body="spatial_task_space.c.jinja",
-        c_context=_c_context(structure),
+        c_context=c_context(structure),
     )
 
 
 def forward_dynamics(structure: SpatialStructure) -> FunctionSpec:
     """``rpr3_forward_dynamics``: ``q''`` under the efforts ``tau``: ``T q'' = tau - tau0``
     (:func:`task_space_dynamics`' terms), by Gaussian elimination with partial pivoting."""
-    tau = _efforts(structure)
+    tau = efforts(structure)
     acc = pose_arguments(structure)[2]
     return FunctionSpec(
         name="forward_dynamics",
@@ -404,7 +294,7 @@ def forward_dynamics(structure: SpatialStructure) -> FunctionSpec:
         program=Program(),
         checks=(Check("inputs_not_finite", "NOT_FINITE"), Check("custom", "SINGULAR")),
         c_body="spatial_task_space.c.jinja",
-        c_context=_c_context(structure, forward=True),
+        c_context=c_context(structure, forward=True),
     )
 
 
@@ -413,7 +303,7 @@ def payload_efforts(structure: SpatialStructure) -> FunctionSpec:
     the inverse dynamics at ``(q, 0, 0)`` with the gravity zeroed (what no inertial parameter
     scales; ``templates/spatial_payload.c.jinja``)."""
     params = param_names(structure)
-    context = dict(_c_context(structure))
+    context = dict(c_context(structure))
     unit = "N m" if structure.actuated_kind == "R" else "N"
     return FunctionSpec(
         name="payload_efforts",
@@ -445,105 +335,6 @@ def payload_efforts(structure: SpatialStructure) -> FunctionSpec:
 
 
 #: Unit and meaning of each inertial quantity (docs/spatial-robots.md, "Identification").
-_PI_DOCS: dict[str, tuple[str, str]] = {
-    "m": ("kg", "mass"),
-    "mc": ("kg m", "first moment along the rod, about its upper S"),
-    "I": ("kg m^2", "inertia across the rod, about its upper S"),
-    **{f"mc{a}": ("kg m", f"first moment {a}") for a in "xyz"},
-    **{
-        f"I{e}": ("kg m^2", f"inertia tensor entry {e}")
-        for e in ("xx", "yy", "zz", "xy", "xz", "yz")
-    },
-}
-
-
-def _pi_component(name: str) -> Component:
-    quantity, _, body = name.partition("_")
-    unit, meaning = _PI_DOCS[quantity]
-    if body == "3":
-        where = "the platform, about its frame's origin, platform axes"
-    elif body[0] == "r":
-        where = f"each rod of leg {body[1:]}"
-    else:
-        where = f"body {body[0]} of leg {body[1:]}, about its first joint point, world axes at home"
-    return Component(name, unit, f"{meaning} of {where}")
-
-
-def inertial_parameters(structure: SpatialStructure) -> Argument:
-    """The inertial parameters pi, the columns of Y: C table ``rpr3_inertial_parameter_names``."""
-    names = identification.parameter_names(structure)
-    return Argument(
-        "pi",
-        tuple(sp.Symbol(f"pi_{n}", real=True) for n in names),
-        tuple(_pi_component(n) for n in names),
-        "inertial parameters (per body m, m c, the inertia tensor about its first joint point; "
-        "per rod m, m c, I about its upper S)",
-        table="inertial_parameter_names",
-    )
-
-
-def regressor(structure: SpatialStructure) -> FunctionSpec:
-    """``rpr3_regressor``: ``Y`` (k x P, row-major) with ``tau = Y pi + tau_payload``, from ``P``
-    evaluations of the inverse dynamics (``templates/spatial_regressor.c.jinja``)."""
-    names = identification.parameter_names(structure)
-    context = dict(_c_context(structure))
-    unit = "N m" if structure.actuated_kind == "R" else "N"
-    bodies, first = [], 0
-    for b in identification.bodies(structure):
-        bodies.append(
-            {
-                "name": b.name,
-                "rod": b.rod,
-                "mass": b.mass,
-                "com": list(b.com),
-                "inertia": list(b.inertia),
-                "reference": list(b.reference) if b.reference else None,
-                "tip": list(b.tip) if b.tip else None,
-                "first": first,
-            }
-        )
-        first += len(b.quantities)
-    return FunctionSpec(
-        name="regressor",
-        doc=f"Identification regressor Y ({structure.dof} x {len(names)}, row-major; row i: "
-        "the effort of leg i; column j: INERTIAL_PARAMETER_NAMES[j]) with tau = Y pi + "
-        "tau_payload: column j is the inverse dynamics' efforts for the model numbers whose "
-        "inertial parameters are the unit vector e_j (every other body massless, no payload).",
-        inputs=pose_arguments(structure),
-        outputs=(
-            Output(
-                "Y",
-                (sp.Integer(0),) * (len(structure.legs) * len(names)),
-                tuple(
-                    Component(
-                        f"Y_{leg}__{name}",
-                        f"{unit} / ({_PI_DOCS[name.partition('_')[0]][0]})",
-                        f"d tau_{leg} / d {name}",
-                    )
-                    for leg in structure.legs
-                    for name in names
-                ),
-                f"Y = d tau / d pi, row-major ({len(structure.legs)} x {len(names)}; columns: "
-                "rpr3_inertial_parameter_names)",
-            ),
-        ),
-        program=Program(),
-        checks=(Check("inputs_not_finite", "NOT_FINITE"), Check("custom", "SINGULAR")),
-        c_body="spatial_regressor.c.jinja",
-        c_context=(
-            ("k", structure.dof),
-            ("outputs", context["outputs"]),
-            ("tau", context["tau"]),
-            ("params", context["params"]),
-            ("zeroed", list(identification.zeroed(structure))),
-            ("columns", len(names)),
-            ("bodies", bodies),
-        ),
-    )
-
-
-#: The tracked forward kinematics' numbers: Newton steps, halvings of a step, convergence on
-#: the largest residual |qa(q) - qa| (rad or m).
 FK_TUNING: tuple[tuple[str, object], ...] = (("max_iter", 30), ("max_halvings", 30),
                                              ("tol", "1e-12"))  # fmt: skip
 
@@ -553,7 +344,7 @@ def forward_kinematics(structure: SpatialStructure) -> FunctionSpec:
     reaches from the reference pose ``q_near`` (``templates/spatial_forward_kinematics.c.jinja``;
     the runtime's NumPy version is the same iteration)."""
     q = pose_arguments(structure)[0]
-    d = _derivation(structure)
+    d = derivation(structure)
     qa = _qa(structure, d)
     qa_arg = Argument(
         "qa",
@@ -585,8 +376,8 @@ def forward_kinematics(structure: SpatialStructure) -> FunctionSpec:
 
 def _efforts_program(structure: SpatialStructure) -> FunctionSpec:
     """The efforts alone as a program (not generated: the source of their derivatives)."""
-    d = _derivation(structure)
-    tau = _efforts(structure)
+    d = derivation(structure)
+    tau = efforts(structure)
     return FunctionSpec(
         name="efforts_program",
         doc="the inverse dynamics' efforts",
@@ -600,7 +391,7 @@ def _efforts_program(structure: SpatialStructure) -> FunctionSpec:
             ),
         ),
         program=d.program,
-        checks=_checks(d),
+        checks=checks(d),
     )
 
 
@@ -663,7 +454,7 @@ def module(
 
 def clear_cache() -> None:
     """Forget the derivations made so far (they are made once per process otherwise)."""
-    _derivation.cache_clear()
+    derivation.cache_clear()
 
 
 __all__ = ["FUNCTIONS", "Program", "module"]

@@ -122,7 +122,7 @@ def evaluate(
         model: the robot; its ``actuation`` (and ``generated`` folder) pick the variant.
         function: the function's name in the manifest (e.g. ``"inverse_dynamics"``).
         inputs: one array per input of the function, each (n, size) (or (size,) for one sample).
-        backend: ``"numpy"`` or ``"c"``.
+        backend: ``"numpy"``, ``"c"`` or ``"jax"`` (the extra ``jax``: docs/bridges.md).
         progress: show a progress bar on stderr when it is a terminal (long runs).
         threads: threads of the ``"c"`` backend (default: every core this process may use);
             the results do not depend on it, bit for bit. The NumPy backend uses one.
@@ -189,8 +189,8 @@ def inverse_dynamics(
             hexapod, (n, 3) ``(x, y, z)`` for a Delta.
         qd: (n, 3) velocity (dx, dy, dphi), or the spatial pose's rates.
         qdd: (n, 3) acceleration (ddx, ddy, ddphi), or the spatial pose's accelerations.
-        backend: ``"numpy"`` (generated NumPy) or ``"c"`` (generated C, compiled on first use
-            and cached; see :mod:`rpr3gen.cbackend`).
+        backend: ``"numpy"`` (generated NumPy), ``"jax"`` (docs/bridges.md) or ``"c"``
+            (generated C, compiled on first use and cached; see :mod:`rpr3gen.cbackend`).
         progress: show a progress bar on stderr when it is a terminal (long trajectories).
         threads: threads of the ``"c"`` backend (default: every core); same results whatever.
 

@@ -3,7 +3,8 @@
 An :class:`Evaluator` evaluates any function of a generated variant's manifest over a block of
 samples (:meth:`~Evaluator.run`) into output arrays it allocates in its own layout
 (:meth:`~Evaluator.allocate`; always seen as (n, size)). ``numpy`` runs the generated NumPy
-module; ``c`` the generated C, compiled and bound by :mod:`rpr3gen.cbackend`, on every core:
+module; ``jax`` its graph module through JAX (:class:`rpr3gen.jax_graph.JaxEvaluator`, the extra
+``jax``); ``c`` the generated C, compiled and bound by :mod:`rpr3gen.cbackend`, on every core:
 its batch functions are re-entrant and ctypes releases the GIL while they run, so contiguous
 chunks of a block run on a pool of threads (:data:`threads`). Neither knows any function in
 particular: both read the manifest.
@@ -37,7 +38,7 @@ __all__ = [
     "thread_count",
 ]
 
-BACKENDS: tuple[str, ...] = ("numpy", "c")
+BACKENDS: tuple[str, ...] = ("numpy", "c", "jax")
 
 
 def all_cores() -> int:
@@ -250,7 +251,8 @@ _EVALUATORS: dict[tuple[str, str], Evaluator] = {}
 
 
 def evaluator(variant: Variant, backend: str) -> Evaluator:
-    """The evaluator of ``variant`` for ``backend`` (``"numpy"`` or ``"c"``), made once."""
+    """The evaluator of ``variant`` for ``backend`` (``"numpy"``, ``"c"`` or ``"jax"``), made
+    once."""
     key = (str(variant.folder), backend)
     found = _EVALUATORS.get(key)
     if found is not None and found.variant.source_hash == variant.source_hash:
@@ -259,6 +261,10 @@ def evaluator(variant: Variant, backend: str) -> Evaluator:
         made: Evaluator = NumpyEvaluator(variant)
     elif backend == "c":
         made = CEvaluator(variant)
+    elif backend == "jax":
+        from rpr3gen.jax_graph import JaxEvaluator  # imports JAX on first use (the extra "jax")
+
+        made = JaxEvaluator(variant)
     else:
         raise InputError(f"unknown backend {backend!r}; choose one of {', '.join(BACKENDS)}")
     _EVALUATORS[key] = made

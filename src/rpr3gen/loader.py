@@ -29,7 +29,7 @@ from rpr3gen import manifest
 from rpr3gen.errors import Rpr3genError
 from rpr3gen.manifest import Variant, regenerate_hint
 
-__all__ = ["check_folder", "numpy_module"]
+__all__ = ["check_folder", "graph_module", "numpy_module"]
 
 _HASH_LINE = "Source hash: "
 
@@ -108,6 +108,44 @@ def numpy_module(variant: Variant) -> ModuleType:
             getattr(module, info.numpy_function, None)
         ):
             raise _fail(path, f"no function {info.numpy_function} (the manifest lists it)", variant)
+    sys.modules[name] = module
+    return module
+
+
+def graph_module(variant: Variant) -> ModuleType:
+    """The generated graph module of a variant (``rpr3_graph.py``, scalar Python over a math
+    namespace: the bridges' source, docs/bridges.md), imported and checked as
+    :func:`numpy_module` is.
+
+    Raises:
+        Rpr3genError: the folder has no graph module (generated before it), or it does not
+            import, or it is another variant's, or it lacks a function the manifest lists.
+    """
+    if "graph" not in variant.files:
+        raise _fail(
+            variant.folder / "manifest.json",
+            "lists no graph module (rpr3_graph.py: generated before the bridges)",
+            variant,
+        )
+    path = variant.path("graph")
+    name = f"_rpr3gen_graph_{variant.variant}_{variant.source_hash[:16]}"
+    module = sys.modules.get(name)
+    if module is not None and getattr(module, "__file__", None) == str(path):
+        return module
+    check_files(variant)
+    try:
+        module = _imported(path, name)
+    except SyntaxError as exc:
+        raise _fail(path, f"line {exc.lineno}: {exc.msg} (syntax error)", variant) from None
+    except Exception as exc:
+        raise _fail(path, f"fails on import: {type(exc).__name__}: {exc}", variant) from None
+    if getattr(module, "VARIANT", None) != variant.variant:
+        raise _fail(path, f"not the {variant.variant} variant of its manifest", variant)
+    if tuple(getattr(module, "PARAM_NAMES", ())) != variant.param_names:
+        raise _fail(path, "takes other parameters than its manifest lists", variant)
+    for info in variant.functions.values():
+        if info.numpy_function is not None and not callable(getattr(module, info.name, None)):
+            raise _fail(path, f"no function {info.name} (the manifest lists it)", variant)
     sys.modules[name] = module
     return module
 
