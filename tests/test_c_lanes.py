@@ -225,3 +225,43 @@ def test_the_hexapods_kernels_run_six_legs_as_lanes(repo_root: Path) -> None:
     assert "for (i = 0; i < 4; ++i)" not in body
     assert "double params_by_leg[256];" in body
     assert "params[96]" not in body  # leg D's first parameter: read by the lanes
+
+
+@pytest.mark.slow
+def test_the_hexapods_single_calls_give_the_batchs_bits(repo_root: Path) -> None:
+    """The 6-UPS built with the runtime's flags (its legs as 8 lanes, which gcc vectorises):
+    every function's single call, sample by sample, gives the bits of its batch (which runs the
+    statements one leg after the other), along the gallery's trajectory."""
+    import ctypes
+
+    import numpy as np
+
+    import rpr3gen
+    from rpr3gen import cbackend, control, variants
+
+    model = rpr3gen.load_model(repo_root / "models" / "tsai-ups.toml")
+    traj = rpr3gen.read_trajectory_csv(
+        repo_root / "models" / "tsai-ups.csv", pose=model.structure.pose
+    )
+    pick = np.linspace(0, len(traj.t) - 1, 48).astype(int)
+    q, qd, qdd = traj.q[pick], traj.qd[pick], traj.qdd[pick]
+    tau = control.actuator_efforts(model, q, qd, qdd)
+    qa = control.actuator_coordinates(model, q)
+    inputs = {"q": q, "qd": qd, "qdd": qdd, "tau": tau, "qa": qa, "q_near": q + 1e-3}
+    variant = variants.load(model.structure, model.generated)
+    assert variant.variant == "ups_2"
+    library = cbackend.library(variant)
+    params = np.ascontiguousarray(model.vector(variant.param_names))
+    ptr = ctypes.c_void_p
+    for fname, info in variant.functions.items():
+        args = [np.ascontiguousarray(inputs[arg.name], dtype=float) for arg in info.inputs]
+        batch, codes = rpr3gen.evaluate(model, fname, args, "c")
+        assert not codes.any(), fname
+        single = library.entries[fname].single
+        for k in range(len(q)):
+            ins = [np.ascontiguousarray(a[k]) for a in args]
+            row = [np.empty(o.size) for o in info.public_outputs]
+            code = single(ptr(params.ctypes.data), *(ptr(a.ctypes.data) for a in (*ins, *row)))
+            assert code == 0, fname
+            for got, want in zip(row, batch, strict=True):
+                assert got.tobytes() == want[k].tobytes(), (fname, k)

@@ -25,18 +25,17 @@ read back just before its first reader as the leg's scalar (``const double rx_B 
 rx_legs[1];``).
 
 A padding lane (lane 3 of three legs) loads ``params[k0 + 3 d]``: an unrelated parameter, so its
-values mean nothing and are never read. That holds for strides ``d`` of 1 and 2 inside the
-vector (the paper's formats). A leg's parameters at a larger stride (the general format: 17 per
-leg; a spatial leg's: 32) are one interleaved group of 17 (or 32) loads to gcc's loop
-vectoriser, which it does not vectorise: the general structures' lane loops ran as scalar loops of four turns (the
-general 3-RPR's inverse dynamics: 206 ns in the single call, against ~100 for the paper's
-variant of the same robot). So the kernel first copies those parameters leg by leg,
-:data:`BY_LEG`: ``by_leg[W k + leg]`` is leg ``leg``'s parameter ``k`` of its block, ``W`` the
-loop's width (the padding lanes hold 0.0, and never read past the vector), a copy that gcc
-vectorises as a transposition, and the lanes load ``by_leg[W k + i]``, contiguous (133 ns). A
-padding lane's arithmetic can raise floating-point exception flags the legs would not raise;
-the library is built with ``-fno-trapping-math`` and does not support running with
-floating-point traps enabled.
+values mean nothing and are never read. That holds for strides ``d`` of 1 and 2 inside the vector
+(the paper's formats). A leg's parameters at a larger stride (the general format: 17 per leg; a
+spatial leg's: 32) are one interleaved group of 17 (or 32) loads to gcc's loop vectoriser, which it
+does not vectorise: the general structures' lane loops ran as scalar loops of four turns (the
+general 3-RPR's inverse dynamics: 206 ns in the single call, against ~100 for the paper's variant of
+the same robot). So the kernel first copies those parameters leg by leg, :data:`BY_LEG`:
+``by_leg[W k + leg]`` is leg ``leg``'s parameter ``k`` of its block, ``W`` the loop's width (the
+padding lanes hold 0.0, and never read past the vector), a copy that gcc vectorises as a
+transposition, and the lanes load ``by_leg[W k + i]``, contiguous (133 ns). A padding lane's
+arithmetic can raise floating-point exception flags the legs would not raise; the library is built
+with ``-fno-trapping-math`` and does not support running with floating-point traps enabled.
 """
 
 from __future__ import annotations
