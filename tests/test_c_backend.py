@@ -240,7 +240,7 @@ def test_build_is_cached_and_rebuilt_when_the_source_changes(
     assert first.stat().st_mtime_ns == stamp  # reused, not rebuilt
     source, header = cbackend.sources(variant)
     monkeypatch.setattr(
-        cbackend, "sources", lambda variant: (source + b"\n/* changed */\n", header)
+        cbackend, "sources", lambda variant, unit="": (source + b"\n/* changed */\n", header)
     )
     second = cbackend.library_path(variant)
     assert second != first

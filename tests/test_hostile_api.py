@@ -791,6 +791,30 @@ def apis(s: Scene) -> tuple[Api, ...]:
             same_length=(("q", "qd", "tau"),),
         ),
         _api(
+            "inverse_dynamics_derivatives",
+            good=lambda tmp: {"model": model, "q": q, "qd": qd, "qdd": qdd, **on},
+            kinds={
+                "model": model_kind,
+                "q": MOTION,
+                "qd": MOTION,
+                "qdd": MOTION,
+                "backend": backend,
+            },
+            same_length=(("q", "qd", "qdd"),),
+        ),
+        _api(
+            "forward_dynamics_derivatives",
+            good=lambda tmp: {"model": model, "q": q, "qd": qd, "tau": s.tau, **on},
+            kinds={
+                "model": model_kind,
+                "q": MOTION,
+                "qd": MOTION,
+                "tau": MOTION,
+                "backend": backend,
+            },
+            same_length=(("q", "qd", "tau"),),
+        ),
+        _api(
             "assembly_modes",
             good=lambda tmp: {"model": model, "qa": s.qa[0], **on},
             kinds={"model": model_kind, "qa": reading(3), "backend": backend},

@@ -55,7 +55,13 @@ def compile_function(spec: FunctionSpec, params: Argument, legs: str = "") -> Co
     if spec.c_body is not None:  # a hand-written kernel body: nothing to eliminate
         return Compiled(spec, StraightLine((), (), 0, 0), (), (), tuple((o, k) for o, k, _ in flat))
     reserved = frozenset(str(s) for arg in (params, *spec.inputs) for s in arg.symbols)
-    code = straight_line(spec.program, [(f"{o}[{k}]", e) for o, k, e in flat], reserved, legs)
+    code = straight_line(
+        spec.program,
+        [(f"{o}[{k}]", e) for o, k, e in flat],
+        reserved,
+        eliminate=not spec.straight,
+        legs=legs,
+    )
     used = set().union(*(rhs.free_symbols for _, rhs in code.assignments + code.outputs))
     names = {str(s) for s in used}
     unknown = names - {str(s) for s in params.symbols} - {str(s) for s, _ in code.assignments}

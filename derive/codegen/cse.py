@@ -59,17 +59,23 @@ def straight_line(
     program: Program,
     outputs: Sequence[tuple[str, sp.Expr]],
     reserved: frozenset[str] = frozenset(),
+    eliminate: bool = True,
     legs: str = "",
 ) -> StraightLine:
     """Eliminate common subexpressions across ``program`` and the ``(label, expr)`` outputs;
     ``reserved``: names a renamed temporary must not take (the parameters', the inputs');
-    ``legs``: the module's legs' letters, whose temporaries get per-leg names."""
+    ``eliminate`` False: the program is already free of them (as :mod:`.adjoint` writes it),
+    its live statements are kept as they are; ``legs``: the module's legs' letters, whose
+    temporaries get per-leg names."""
     live = _live(program, outputs)
     exprs = [expr for _, expr in live] + [expr for _, expr in outputs]
     ops_before = count_ops(exprs)
-    temporaries, reduced = sp.cse(
-        exprs, symbols=sp.numbered_symbols("x", real=True), order="canonical"
-    )
+    if eliminate:
+        temporaries, reduced = sp.cse(
+            exprs, symbols=sp.numbered_symbols("x", real=True), order="canonical"
+        )
+    else:
+        temporaries, reduced = [], exprs
     temp_defs = dict(temporaries)
     temp_order = {sym: k for k, (sym, _) in enumerate(temporaries)}
     emitted: set[sp.Symbol] = set()

@@ -74,6 +74,7 @@ def manifest(module: ModuleSpec, digest: str, files: dict[str, str]) -> str:
                 "c_symbol": f"{prefix}_{f.name}",
                 "c_batch_symbol": f"{prefix}_{f.name}_batch",
                 "numpy_function": None if f.c_body else f"{prefix}_{f.name}",
+                "unit": f.unit,
                 "doc": f.doc,
                 "inputs": [
                     {"name": a.name, "doc": a.doc, "components": _components(a)} for a in f.inputs

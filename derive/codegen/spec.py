@@ -153,6 +153,15 @@ class FunctionSpec:
     #: Functions whose values-only kernel (``{prefix}_{name}_values``: the public outputs, no
     #: check, no hidden output) the hand-written body calls.
     c_values: tuple[str, ...] = ()
+    #: The C translation unit of the function: "" the variant's source, else a source file of
+    #: its own (``{prefix}_{unit}.c``) that the runtime compiles, into a library of its own
+    #: linked to the main one, only when one of its functions is first called (the derivatives:
+    #: large kernels that need not slow every first use). Its hand-written body may call the
+    #: main unit's public functions, not its kernels.
+    unit: str = ""
+    #: The program is already free of common subexpressions (written so by
+    #: :mod:`rpr3gen_derive.codegen.adjoint`): the engine keeps its statements as they are.
+    straight: bool = False
 
     def __post_init__(self) -> None:
         guards = [c.guard for c in self.checks if c.guard is not None]

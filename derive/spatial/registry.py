@@ -13,6 +13,7 @@ from collections.abc import Callable, Mapping
 from functools import cache
 
 import sympy as sp
+from rpr3gen_derive.codegen import derivatives
 from rpr3gen_derive.codegen.program import Program
 from rpr3gen_derive.codegen.spec import (
     Argument,
@@ -582,6 +583,40 @@ def forward_kinematics(structure: SpatialStructure) -> FunctionSpec:
     )
 
 
+def _efforts_program(structure: SpatialStructure) -> FunctionSpec:
+    """The efforts alone as a program (not generated: the source of their derivatives)."""
+    d = _derivation(structure)
+    tau = _efforts(structure)
+    return FunctionSpec(
+        name="efforts_program",
+        doc="the inverse dynamics' efforts",
+        inputs=pose_arguments(structure),
+        outputs=(
+            Output(
+                "tau",
+                tuple(d.outputs[c.name] for c in tau.components),
+                tau.components,
+                "actuator efforts",
+            ),
+        ),
+        program=d.program,
+        checks=_checks(d),
+    )
+
+
+def inverse_dynamics_derivatives(structure: SpatialStructure) -> FunctionSpec:
+    """``rpr3_inverse_dynamics_derivatives``: ``tau`` and ``d tau / d(q, qd, qdd)``, by
+    reverse mode through the efforts' program (:mod:`rpr3gen_derive.codegen.derivatives`)."""
+    return derivatives.inverse_dynamics_derivatives(_efforts_program(structure))
+
+
+def forward_dynamics_derivatives(structure: SpatialStructure) -> FunctionSpec:
+    """``rpr3_forward_dynamics_derivatives``: ``qdd`` and ``d qdd / d(q, qd, tau)``."""
+    return derivatives.forward_dynamics_derivatives(
+        forward_dynamics(structure), _efforts_program(structure)
+    )
+
+
 FunctionBuilder = Callable[[SpatialStructure], FunctionSpec | None]
 
 FUNCTIONS: Mapping[str, FunctionBuilder] = {
@@ -596,6 +631,8 @@ FUNCTIONS: Mapping[str, FunctionBuilder] = {
     "forward_kinematics": forward_kinematics,
     "payload_efforts": payload_efforts,
     "regressor": regressor,
+    "inverse_dynamics_derivatives": inverse_dynamics_derivatives,
+    "forward_dynamics_derivatives": forward_dynamics_derivatives,
 }
 
 

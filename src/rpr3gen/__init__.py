@@ -56,6 +56,7 @@ from rpr3gen.parameters import (
 )
 from rpr3gen.retiming import retime
 from rpr3gen.sample import SampleEvaluator
+from rpr3gen.sensitivity import forward_dynamics_derivatives, inverse_dynamics_derivatives
 from rpr3gen.trajectory import Trajectory, paper_trajectory, read_trajectory_csv
 from rpr3gen.version import __version__
 
@@ -90,11 +91,13 @@ __all__ = [
     "evaluate",
     "excite",
     "forward_dynamics",
+    "forward_dynamics_derivatives",
     "forward_kinematics",
     "identify",
     "inertial_parameter_names",
     "inertial_parameters",
     "inverse_dynamics",
+    "inverse_dynamics_derivatives",
     "jacobian_rate",
     "load_model",
     "model_from_dict",

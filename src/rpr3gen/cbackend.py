@@ -87,6 +87,11 @@ EXTRA_FLAGS: tuple[tuple[str, ...], ...] = (
 #: no flag that changes one is added. A compiler or linker that refuses it builds with
 #: EXTRA_FLAGS alone.
 PARALLEL_FLAGS: tuple[str, ...] = ("-flto=auto", "-flto-partition=balanced")
+#: A translation unit other than the main one (the derivatives) whose source is larger than
+#: this (bytes) is compiled at -O0: a 6-leg hexapod's derivatives (1.7 MB, one kernel of 58,000
+#: operations) took gcc 12 over 8 minutes and 7 GB at -O3, 260 s at -O1, and take 4 s at -O0
+#: (docs/derivatives.md). Its values are the same: no flag changes one.
+LARGE_UNIT = 1_000_000
 LIBS: tuple[str, ...] = ("-lm",)
 
 
@@ -108,16 +113,23 @@ def _compiler() -> list[str]:
     return command
 
 
-def sources(variant: Variant) -> tuple[bytes, bytes]:
-    """The generated C source and header of a variant, checked (:mod:`rpr3gen.loader`)."""
+def sources(variant: Variant, unit: str = "") -> tuple[bytes, bytes]:
+    """The generated C source of a translation unit (``""``: the variant's main one) and the
+    header, checked (:mod:`rpr3gen.loader`)."""
     check_files(variant)
-    return variant.path("c_source").read_bytes(), variant.path("c_header").read_bytes()
+    return variant.path(_source_role(unit)).read_bytes(), variant.path("c_header").read_bytes()
 
 
-def shim(variant: Variant) -> bytes:
-    """C source of the one-pointer entry points, one per function of the manifest."""
+def _source_role(unit: str) -> str:
+    return f"c_source_{unit}" if unit else "c_source"
+
+
+def shim(variant: Variant, unit: str = "") -> bytes:
+    """C source of the one-pointer entry points, one per function of the unit."""
     lines = [f'#include "{variant.files["c_header"]}"', ""]
     for f in variant.functions.values():
+        if f.unit != unit:
+            continue
         count = 1 + len(f.inputs) + len(f.public_outputs)
         args = ", ".join(
             f"({'const ' if k <= len(f.inputs) else ''}double *)a[{k}]" for k in range(count)
@@ -147,46 +159,66 @@ def _exclusive(lock: Path) -> Iterator[None]:
         os.close(fd)  # releases the lock
 
 
-def library_path(variant: Variant) -> Path:
-    """Path of the compiled library of ``variant``, building it if it is not in the cache."""
-    source, header = sources(variant)
-    glue = shim(variant)
+def library_path(variant: Variant, unit: str = "") -> Path:
+    """Path of the compiled library of ``variant``'s translation unit ``unit`` (``""``: the
+    main one), building it if it is not in the cache. A unit's library is linked to the main
+    library (whose public functions it may call), which is built first."""
+    source, header = sources(variant, unit)
+    glue = shim(variant, unit)
     command = _compiler()
+    link: tuple[str, ...] = ()
+    if unit:
+        main = library_path(variant)
+        link = (str(main), f"-Wl,-rpath,{main.parent}")
+    cflags = CFLAGS
+    if unit and len(source) > LARGE_UNIT:
+        cflags = tuple("-O0" if f == "-O3" else f for f in CFLAGS)
     digest = hashlib.sha256()
-    for part in (source, header, glue, " ".join(command + list(CFLAGS) + list(LIBS)).encode()):
+    flags = " ".join(command + list(cflags) + list(LIBS) + list(link)).encode()
+    for part in (source, header, glue, flags):
         digest.update(part)
         digest.update(b"\0")
     folder = cache_dir()
-    target = folder / f"lib{variant.prefix}_{variant.variant}_{digest.hexdigest()[:20]}.so"
+    name = f"{variant.prefix}_{variant.variant}" + (f"_{unit}" if unit else "")
+    target = folder / f"lib{name}_{digest.hexdigest()[:20]}.so"
     if target.is_file():
         return target
     folder.mkdir(parents=True, exist_ok=True)
     with _exclusive(folder / f".{target.name}.lock"):
         if not target.is_file():  # else built by another process while this one waited
             files = {
-                variant.files["c_source"]: source,
+                variant.files[_source_role(unit)]: source,
                 variant.files["c_header"]: header,
                 "shim.c": glue,
             }
-            _build(variant, command, files, target)
+            source_name = variant.files[_source_role(unit)]
+            _build(variant, command, files, target, source_name, link, cflags)
     return target
 
 
-def _build(variant: Variant, command: list[str], files: dict[str, bytes], target: Path) -> None:
-    """Compile ``files`` into ``target``: in a temporary folder beside it, then renamed."""
+def _build(
+    variant: Variant,
+    command: list[str],
+    files: dict[str, bytes],
+    target: Path,
+    source: str,
+    link: tuple[str, ...] = (),
+    cflags: tuple[str, ...] = CFLAGS,
+) -> None:
+    """Compile ``files`` (``source`` and the shim; ``link``: libraries and flags for the
+    linker) into ``target`` with ``cflags``: in a temporary folder beside it, then renamed."""
     with tempfile.TemporaryDirectory(dir=target.parent, prefix=".build-") as tmp:
         for name, text in files.items():
             (Path(tmp) / name).write_bytes(text)
         built = Path(tmp) / target.name
         for extra in ((*EXTRA_FLAGS[0], *PARALLEL_FLAGS), *EXTRA_FLAGS):
             result = subprocess.run(
-                [*command, *CFLAGS, *extra, variant.files["c_source"], "shim.c", "-o",
-                 built.name, *LIBS],
+                [*command, *cflags, *extra, source, "shim.c", "-o", built.name, *link, *LIBS],
                 cwd=tmp,
                 capture_output=True,
                 text=True,
                 check=False,
-            )  # fmt: skip
+            )
             if result.returncode == 0:
                 break
         else:
@@ -204,22 +236,52 @@ class Entry:
     batch: Any  # size_t f_batch(params, n, inputs..., outputs...)
 
 
+class _Entries(dict[str, "Entry"]):
+    """The entries by function name; a function of another translation unit is looked up, its
+    unit's library built and loaded, when first asked for."""
+
+    def __init__(self, library: Library) -> None:
+        super().__init__()
+        self.library = library
+
+    def __missing__(self, name: str) -> Entry:
+        f = self.library.variant.functions[name]
+        if not f.unit:
+            raise KeyError(name)
+        self.library.load(f.unit)
+        return self[name]
+
+
 class Library:
-    """A compiled variant: the ctypes library and its entries by function name."""
+    """A compiled variant: the ctypes library (the main unit's) and its entries by function
+    name; another unit's functions (the derivatives) load their library on first use."""
 
     def __init__(self, variant: Variant) -> None:
         self.variant = variant
         self.cdll = ctypes.CDLL(str(library_path(variant)))
-        self.entries: dict[str, Entry] = {}
-        for name, f in variant.functions.items():
+        self.units: dict[str, ctypes.CDLL] = {"": self.cdll}
+        self.entries: dict[str, Entry] = _Entries(self)
+        self._bind("")
+
+    def load(self, unit: str) -> None:
+        """Build (if needed) and load the library of ``unit``, and bind its functions."""
+        if unit not in self.units:
+            self.units[unit] = ctypes.CDLL(str(library_path(self.variant, unit)))
+            self._bind(unit)
+
+    def _bind(self, unit: str) -> None:
+        cdll = self.units[unit]
+        for name, f in self.variant.functions.items():
+            if f.unit != unit:
+                continue
             count = len(f.inputs) + len(f.public_outputs)
-            single = getattr(self.cdll, f.c_symbol)
+            single = getattr(cdll, f.c_symbol)
             single.restype = ctypes.c_int
             single.argtypes = [ctypes.c_void_p] * (1 + count)
-            packed = getattr(self.cdll, f"{f.c_symbol}_packed")
+            packed = getattr(cdll, f"{f.c_symbol}_packed")
             packed.restype = ctypes.c_int
             packed.argtypes = [ctypes.c_void_p]
-            batch = getattr(self.cdll, f.c_batch_symbol)
+            batch = getattr(cdll, f.c_batch_symbol)
             batch.restype = ctypes.c_size_t
             batch.argtypes = [ctypes.c_void_p, ctypes.c_size_t] + [ctypes.c_void_p] * count
             self.entries[name] = Entry(single, packed, batch)

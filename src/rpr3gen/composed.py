@@ -37,8 +37,14 @@ LOAD_PARAMS = ("gx", "gy", "gz", "fx", "fy", "fz", "mx", "my", "mz")
 MAX_ITER, MAX_HALVINGS, TOL = 30, 30, 1e-12
 
 
+#: Composed for every robot, planar or spatial.
+EVERY_ROBOT: tuple[str, ...] = ("forward_dynamics_derivatives",)
+
+
 def composable(variant: Variant, function: FunctionInfo) -> bool:
     """Whether ``function`` of ``variant`` has a NumPy composition here."""
+    if function.name in EVERY_ROBOT:
+        return True
     return function.name in COMPOSED and "DOF" in variant.defines
 
 
@@ -51,6 +57,12 @@ def run(
     generated: Runner,
 ) -> None:
     """Evaluate ``function`` into ``outputs`` (each (n, size)); failed samples are NaN rows."""
+    if function.name == "forward_dynamics_derivatives":
+        for out, value in zip(
+            outputs, _forward_derivatives(params, inputs, generated), strict=True
+        ):
+            out[:] = value
+        return
     tau_rows = _tau_rows(variant)
     if function.name == "forward_kinematics":
         outputs[0][:] = _forward_kinematics(params, inputs[0], inputs[1], generated, variant)
@@ -91,6 +103,32 @@ def run(
         result[ok] = solved
     result[~np.isfinite(result).all(axis=1)] = np.nan
     outputs[0][:] = result
+
+
+def _forward_derivatives(
+    params: np.ndarray, inputs: Sequence[np.ndarray], generated: Runner
+) -> list[np.ndarray]:
+    """``q''`` of the forward dynamics and its Jacobians by ``q, q', tau`` (each (n, k*k)):
+    with ``T = d tau / d q''`` of the inverse dynamics derivatives at that ``q''``, ``T X =
+    [-d tau / d q, -d tau / d q', I]`` (derive/codegen/derivatives.py)."""
+    q, qd, tau = inputs
+    n, k = q.shape
+    (qdd,) = generated("forward_dynamics", params, [q, qd, tau])
+    _, dq, dqd, T = generated("inverse_dynamics_derivatives", params, [q, qd, qdd])
+    rhs = np.concatenate(
+        [-dq.reshape(n, k, k), -dqd.reshape(n, k, k), np.broadcast_to(np.eye(k), (n, k, k))],
+        axis=2,
+    )
+    X = np.full((n, k, 3 * k), np.nan)
+    T = T.reshape(n, k, k)
+    ok = np.isfinite(T).all(axis=(1, 2)) & np.isfinite(rhs).all(axis=(1, 2))
+    if ok.any():
+        with np.errstate(all="ignore"):
+            X[ok] = np.linalg.solve(T[ok], rhs[ok])
+    bad = np.asarray(~np.isfinite(X).all(axis=(1, 2)))
+    X[bad] = np.nan
+    qdd = np.where(bad[:, np.newaxis], np.nan, qdd)
+    return [qdd, *(X[:, :, j * k : (j + 1) * k].reshape(n, k * k) for j in range(3))]
 
 
 def _tau_rows(variant: Variant) -> list[int]:

@@ -62,6 +62,9 @@ class FunctionInfo:
     inputs: tuple[ArgInfo, ...]
     outputs: tuple[ArgInfo, ...]  # the public ones first, then any hidden one
     checks: tuple[CheckInfo, ...]
+    #: Its C translation unit: "" the variant's source, else ``c_source_{unit}`` (a library of
+    #: its own, built when one of its functions is first called).
+    unit: str = ""
 
     @property
     def public_outputs(self) -> tuple[ArgInfo, ...]:
@@ -161,6 +164,7 @@ def _function(data: dict, codes: dict[str, int], thresholds: dict[str, float]) -
         inputs=tuple(_arg(a) for a in data["inputs"]),
         outputs=outputs,
         checks=tuple(checks),
+        unit=str(data.get("unit", "")),
     )
 
 

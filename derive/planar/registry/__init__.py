@@ -32,6 +32,10 @@ from rpr3gen_derive.planar.registry.control_model import (
     platform_velocity,
     task_space_dynamics,
 )
+from rpr3gen_derive.planar.registry.derivatives import (
+    forward_dynamics_derivatives,
+    inverse_dynamics_derivatives,
+)
 from rpr3gen_derive.planar.registry.direct_kinematics import (
     assembly_modes,
     fk_kind,
@@ -115,6 +119,8 @@ FUNCTIONS: Mapping[str, FunctionBuilder] = {
     "forward_kinematics_jacobian": forward_kinematics_jacobian,
     "regressor": regressor,
     "payload_efforts": payload_efforts,
+    "inverse_dynamics_derivatives": inverse_dynamics_derivatives,
+    "forward_dynamics_derivatives": forward_dynamics_derivatives,
 }
 
 

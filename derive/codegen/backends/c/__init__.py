@@ -226,36 +226,60 @@ def render(
 
     with stage("print"):
         values = {name for c in compiled for name in c.spec.c_values}
-        functions = [_function(module, c, c.spec.name in values) for c in compiled]
-    tables = name_tables(module, compiled)
-    uses_finite = any(f["input_code"] or f["checks"] for f in functions)
+        functions = {c.spec.name: _function(module, c, c.spec.name in values) for c in compiled}
+    units = sorted({c.spec.unit for c in compiled if c.spec.unit})
+    every = _context(module, compiled, functions, digest)
+    files: dict[str, tuple[str, str]] = {}
+    with stage("render"):
+        header = env.get_template("backends/c/templates/header.h.jinja").render(every)
+        files["c_header"] = (f"{module.prefix}.h", header)
+        source = env.get_template("backends/c/templates/source.c.jinja")
+        main = [c for c in compiled if not c.spec.unit]
+        files["c_source"] = (
+            f"{module.prefix}.c",
+            source.render(_context(module, main, functions, digest, name_tables(module, main))),
+        )
+        for unit in units:
+            members = [c for c in compiled if c.spec.unit == unit]
+            files[f"c_source_{unit}"] = (
+                f"{module.prefix}_{unit}.c",
+                source.render(_context(module, members, functions, digest, [], unit)),
+            )
+        names = {"header": files["c_header"][0], "source": files["c_source"][0]}
+        extra = [files[f"c_source_{unit}"][0] for unit in units]
+        files.update(package.render(module, digest, env, **names, extra_sources=extra))
+    return files
+
+
+def _context(
+    module: ModuleSpec,
+    compiled: list[Compiled],
+    functions: dict[str, dict[str, Any]],
+    digest: str,
+    tables: list[Any] | None = None,
+    unit: str = "",
+) -> dict[str, Any]:
+    """The templates' context for the functions ``compiled`` (one translation unit, or all
+    of them for the header); ``tables``: the name tables the unit defines (the main one)."""
+    chosen = [functions[c.spec.name] for c in compiled]
     kernels = mathkernels.used(
         e for c in compiled for e in [rhs for _, rhs in c.code.assignments + c.code.outputs]
     )
     kernels |= {k for c in compiled for k in c.spec.c_kernels}
-    context = {
+    return {
         "module": module,
-        "functions": functions,
-        "tables": tables,
+        "functions": chosen,
+        "tables": name_tables(module, compiled) if tables is None else tables,
         "source_hash": digest,
         "upper": module.prefix.upper(),
         "prefix": module.prefix,
-        "uses_finite": uses_finite,
-        "ops_before": sum(f["ops_before"] for f in functions),
-        "ops_after": sum(f["ops_after"] for f in functions),
-        "assignments": sum(len(f["assignments"]) for f in functions),
+        "unit": unit,
+        "uses_finite": any(f["input_code"] or f["checks"] for f in chosen),
+        "ops_before": sum(f["ops_before"] for f in chosen),
+        "ops_after": sum(f["ops_after"] for f in chosen),
+        "assignments": sum(len(f["assignments"]) for f in chosen),
         "math": mathkernels.context(kernels),
     }
-    with stage("render"):
-        header = env.get_template("backends/c/templates/header.h.jinja").render(context)
-        source = env.get_template("backends/c/templates/source.c.jinja").render(context)
-        files = {
-            "c_header": (f"{module.prefix}.h", header),
-            "c_source": (f"{module.prefix}.c", source),
-        }
-        names = {"header": files["c_header"][0], "source": files["c_source"][0]}
-        files.update(package.render(module, digest, env, **names))
-    return files
 
 
 __all__ = ["render"]

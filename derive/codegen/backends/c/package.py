@@ -10,6 +10,8 @@ may move). Both carry the generated files' header: "do not edit" and the source 
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import jinja2
 from rpr3gen_derive.codegen.spec import ModuleSpec
 
@@ -25,9 +27,15 @@ def package_name(module: ModuleSpec) -> str:
 
 
 def render(
-    module: ModuleSpec, digest: str, env: jinja2.Environment, header: str, source: str
+    module: ModuleSpec,
+    digest: str,
+    env: jinja2.Environment,
+    header: str,
+    source: str,
+    extra_sources: Sequence[str] = (),
 ) -> dict[str, tuple[str, str]]:
-    """``{"c_cmake": ("CMakeLists.txt", text), "c_pkgconfig": ("<package>.pc.in", text)}``."""
+    """``{"c_cmake": ("CMakeLists.txt", text), "c_pkgconfig": ("<package>.pc.in", text)}``;
+    the library is built from ``source`` and ``extra_sources`` (the other translation units)."""
     package = package_name(module)
     context = {
         "module": module,
@@ -38,6 +46,7 @@ def render(
         "option": package.upper(),
         "header": header,
         "source": source,
+        "sources": " ".join([source, *extra_sources]),
     }
     return {
         "c_cmake": (
