@@ -286,3 +286,19 @@ def test_a_module_without_output_sums_gets_the_same_codes(
         want = [0] * 5 + [variant.return_codes["SINGULAR"]] + [0] * 2
         assert with_sums[1].tolist() == without[1].tolist() == want[:n]
         np.testing.assert_array_equal(with_sums[0][0], without[0][0])
+
+
+def test_a_modules_legs_are_distinct_capital_letters() -> None:
+    """``ModuleSpec.legs`` names the legs the engine runs side by side: the planar modules'
+    ``ABC``, a hexapod's ``ABCDEF``; none (the default) for a module of no legs."""
+    from rpr3gen_derive.codegen.spec import Argument, ModuleSpec, ReturnCode
+
+    x = sp.Symbol("x", real=True)
+    params = Argument("params", (x,), (Component("x"),), "params", "param_names")
+    ok = (ReturnCode("OK", 0, "ok"),)
+    assert registry.module(S["revolute"], functions={}).legs == "ABC"
+    assert ModuleSpec("p", "v", "doc", params, (), ok).legs == ""
+    assert ModuleSpec("p", "v", "doc", params, (), ok, legs="ABCDEF").legs == "ABCDEF"
+    for bad in ("ABA", "AbC", "A1"):
+        with pytest.raises(ValueError, match="distinct capital letters"):
+            ModuleSpec("p", "v", "doc", params, (), ok, legs=bad)

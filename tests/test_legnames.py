@@ -24,7 +24,7 @@ def test_one_expression_of_three_legs_gets_leg_as_number_and_letters() -> None:
         (x3, x1 * x5),  # two legs: stays
     ]
     outputs = [("out[0]", x2 + x6 + x10 + x3)]
-    renamed, outs = leg_names(lines, outputs, {x1, x5, x9, x2, x6, x10, x3})
+    renamed, outs = leg_names(lines, outputs, {x1, x5, x9, x2, x6, x10, x3}, legs="ABC")
     names = [str(s) for s, _ in renamed]
     assert names == ["x1_A", "x1_B", "x1_C", "x2_A", "x2_B", "x2_C", "x3"]
     x1_A, x1_B = sp.Symbol("x1_A", real=True), sp.Symbol("x1_B", real=True)
@@ -38,13 +38,13 @@ def test_one_expression_of_three_legs_gets_leg_as_number_and_letters() -> None:
 
 def test_different_expressions_keep_their_names() -> None:
     lines = [(x1, xA1 * c), (x5, xB1 + c), (x9, xC1 * c)]
-    renamed, _ = leg_names(lines, [("out[0]", x1 + x5 + x9)], {x1, x5, x9})
+    renamed, _ = leg_names(lines, [("out[0]", x1 + x5 + x9)], {x1, x5, x9}, legs="ABC")
     assert [str(s) for s, _ in renamed] == ["x1", "x5", "x9"]
 
 
 def test_program_symbols_are_never_renamed() -> None:
     lines = [(out_A, xA1 * c)]
-    renamed, _ = leg_names(lines, [("out[0]", out_A)], set())
+    renamed, _ = leg_names(lines, [("out[0]", out_A)], set(), legs="ABC")
     assert renamed == lines
 
 
@@ -54,12 +54,36 @@ def test_a_parameter_name_is_never_taken() -> None:
     name); the legs' names then join the letter with two underscores, or three."""
     lines = [(x1, xA1 * c), (x5, xB1 * c), (x9, xC1 * c)]
     outputs = [("out[0]", x1 + x5 + x9)]
-    renamed, _ = leg_names(lines, outputs, {x1, x5, x9}, frozenset({"x1_B"}))
+    renamed, _ = leg_names(lines, outputs, {x1, x5, x9}, frozenset({"x1_B"}), legs="ABC")
     assert [str(s) for s, _ in renamed] == ["x1__A", "x1__B", "x1__C"]
-    renamed, _ = leg_names(lines, outputs, {x1, x5, x9}, frozenset({"x1_B", "x1__C"}))
+    renamed, _ = leg_names(lines, outputs, {x1, x5, x9}, frozenset({"x1_B", "x1__C"}), legs="ABC")
     assert [str(s) for s, _ in renamed] == ["x1___A", "x1___B", "x1___C"]
-    renamed, _ = leg_names(lines, outputs, {x1, x5, x9})
+    renamed, _ = leg_names(lines, outputs, {x1, x5, x9}, legs="ABC")
     assert [str(s) for s, _ in renamed] == ["x1_A", "x1_B", "x1_C"]
+
+
+def test_six_legs_are_renamed_when_all_six_are_alike() -> None:
+    """A hexapod's legs, ``ABCDEF``: six temporaries, one expression per leg, get the first
+    one's number and each leg's letter; the same six read as legs ``ABC`` keep their names for
+    D, E, F (no family of theirs), and where only three legs are alike no name changes."""
+    legs = "ABCDEF"
+    p = {leg: sp.Symbol(f"x{leg}1", real=True) for leg in legs}
+    t = {leg: sp.Symbol(f"x{k * 4 + 1}", real=True) for k, leg in enumerate(legs)}
+    lines = [(t[leg], p[leg] * c) for leg in legs]
+    outputs = [("out[0]", sum(t.values()))]
+    renamed, _ = leg_names(lines, outputs, set(t.values()), legs=legs)
+    assert [str(x) for x, _ in renamed] == [f"x1_{leg}" for leg in legs]
+    renamed, _ = leg_names(lines, outputs, set(t.values()), legs="ABC")
+    assert [str(x) for x, _ in renamed] == ["x1_A", "x1_B", "x1_C", "x13", "x17", "x21"]
+    mixed = [(t[leg], p[leg] * c if leg in "ABC" else p[leg] + c) for leg in legs]
+    renamed, _ = leg_names(mixed, outputs, set(t.values()), legs=legs)
+    assert renamed == mixed
+
+
+def test_no_legs_no_names() -> None:
+    lines = [(x1, xA1 * c), (x5, xB1 * c), (x9, xC1 * c)]
+    outputs = [("out[0]", x1 + x5 + x9)]
+    assert leg_names(lines, outputs, {x1, x5, x9}, legs="") == (lines, outputs)
 
 
 def _tree(rng: random.Random, leaves: list[sp.Expr], depth: int) -> sp.Expr:

@@ -405,8 +405,8 @@ def _run_legs(lowered, constants, s, values, n: int) -> tuple[np.ndarray, np.nda
     work = np.full((max(lowered.buffers, 1), n), np.nan)
     for i in range(lowered.buffers):
         scope[f"w{i}"] = work[i]
-    for first in lowered.triples:
-        scope[f"t{first}"] = work[first : first + 3]
+    for first in lowered.blocks:
+        scope[f"t{first}"] = work[first : first + lowered.legs]
     exec("\n".join(lowered.scalar_lines + lowered.vector_lines), scope)
     return out, scope["sums"]
 
@@ -430,8 +430,8 @@ def test_the_legs_statements_run_as_one_call_for_three_legs(
     params = {s["pA"], s["pB"], s["pC"], s["c"]}
     rows = {name: f"out[{i}]" for i, (name, _) in enumerate(code.outputs)}
     constants: dict[str, str] = {}
-    stacked = lower_numpy(code, inputs, params, rows, constants)
-    assert stacked.triples, stacked.vector_lines
+    stacked = lower_numpy(code, inputs, params, rows, constants, "ABC")
+    assert stacked.blocks, stacked.vector_lines
     assert any("out[0:3]" in line for line in stacked.vector_lines)  # p_A, p_B, p_C at once
     assert not any("out[4:7]" in line for line in stacked.vector_lines)  # y: another order
     got, sums = _run_legs(stacked, constants, s, values, n)
@@ -449,7 +449,54 @@ def test_the_legs_statements_run_as_one_call_for_three_legs(
     np.testing.assert_array_equal(sums, np.add.reduce(got, axis=1))
 
     monkeypatch.setattr(groups, "MIN_GROUPS", 10**6)  # the same program, leg by leg
-    alone = lower_numpy(code, inputs, params, rows, {})
-    assert not alone.triples
+    alone = lower_numpy(code, inputs, params, rows, {}, "ABC")
+    assert not alone.blocks
     # r, s, q (two operations) and p: five operations, each one call for three legs
     assert len(_calls(stacked)) == len(_calls(alone)) - 2 * 5
+
+
+def test_six_legs_run_on_six_row_blocks() -> None:
+    """A hexapod's legs (``ABCDEF``): each operation of their alike statements is one call on a
+    (6, n) block, the legs' output rows written and summed at once, each leg's values those of
+    its own statements, bit for bit."""
+    legs = "ABCDEF"
+    s = {name: sp.Symbol(name, real=True) for name in
+         ["u", "v", "c"] + [f"p{leg}" for leg in legs]
+         + [f"{x}_{leg}" for x in "rstq" for leg in legs]}  # fmt: skip
+    lines = []
+    for leg in legs:
+        lines += [
+            (s[f"r_{leg}"], s["u"] + s[f"p{leg}"]),
+            (s[f"s_{leg}"], s[f"r_{leg}"] * s["v"] - s["c"]),
+            (s[f"t_{leg}"], s[f"s_{leg}"] ** 2 + s["c"]),
+            (s[f"q_{leg}"], sp.sqrt(s[f"t_{leg}"])),
+        ]
+    outputs = [(f"q_{leg}", s[f"q_{leg}"]) for leg in legs]
+    code = StraightLine(tuple(lines), tuple(outputs), 0, 0)
+    rng = np.random.default_rng(6)
+    n = 24
+    values = {"u": rng.uniform(-1, 1, n), "v": rng.uniform(-1, 1, n), "c": 1.5}
+    values.update({f"p{leg}": 0.1 * k - 0.2 for k, leg in enumerate(legs)})
+    params = {s["c"], *(s[f"p{leg}"] for leg in legs)}
+    rows = {name: f"out[{i}]" for i, (name, _) in enumerate(outputs)}
+    constants: dict[str, str] = {}
+    lowered = lower_numpy(code, {s["u"]: "u", s["v"]: "v"}, params, rows, constants, legs)
+    assert lowered.legs == 6
+    assert lowered.blocks, lowered.vector_lines
+    assert any("out[0:6]" in line for line in lowered.vector_lines)
+    assert any("sums[0:6]" in line for line in lowered.vector_lines)
+    out = np.full((6, n), np.nan)
+    scope = {"numpy": np, "out": out, **values, **_module_names(lowered, constants)}
+    work = np.full((max(lowered.buffers, 1), n), np.nan)
+    for i in range(lowered.buffers):
+        scope[f"w{i}"] = work[i]
+    for first in lowered.blocks:
+        scope[f"t{first}"] = work[first : first + 6]
+    exec("\n".join(lowered.scalar_lines + lowered.vector_lines), scope)
+    u, v, c = values["u"], values["v"], values["c"]
+    for k, leg in enumerate(legs):
+        want = np.sqrt((((u + values[f"p{leg}"]) * v) - c) ** 2 + c)
+        np.testing.assert_array_equal(out[k], want)
+    three = lower_numpy(code, {s["u"]: "u", s["v"]: "v"}, params, rows, {}, "ABC")
+    assert three.legs == 3  # as three legs (as before): A, B, C in blocks, D, E, F one by one
+    assert len(_calls(three)) > len(_calls(lowered))

@@ -28,7 +28,6 @@ from pathlib import Path
 from typing import Any
 
 from rpr3gen_derive.codegen.backends.c.lanes import LOOP
-from rpr3gen_derive.codegen.legnames import LEGS
 
 from harness import chain, samples
 from rpr3gen import cbackend
@@ -52,8 +51,10 @@ def kernel_calls(source: str, prefix: str) -> dict[str, dict[str, int]]:
         found = dict.fromkeys(LIBM, 0)
         legs, close = 1, None  # inside a lane loop: its calls run once per leg
         for line in body.splitlines():
-            if line.strip() == LOOP:
-                legs, close = len(LEGS), line[: len(line) - len(line.lstrip())] + "}"
+            opened = LOOP.fullmatch(line.strip())
+            if opened:  # the loop's comment names its legs
+                legs = len(opened["legs"].split(", "))
+                close = line[: len(line) - len(line.lstrip())] + "}"
             elif line == close:
                 legs, close = 1, None
             for f in LIBM:

@@ -74,7 +74,7 @@ def critical_path(body: str, latency: Mapping[str, float], prefix: str = "rpr3")
     lines = body.split("{", 1)[1].splitlines()  # after the signature
     for line in lines:
         text = line.strip()
-        if not text or text == LOOP or _SKIP.fullmatch(text):
+        if not text or LOOP.fullmatch(text) or _SKIP.fullmatch(text):
             continue
         pair = re.fullmatch(rf"{prefix}_sincos\((.+), &(\w+), &(\w+)\);", text)
         if pair is not None:  # sin and cos of one argument, side by side

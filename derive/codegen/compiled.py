@@ -48,14 +48,19 @@ class Compiled:
         return {params.symbols[k] for k, _ in self.used_params}
 
 
-def compile_function(spec: FunctionSpec, params: Argument) -> Compiled:
-    """Eliminate common subexpressions of ``spec`` and record which inputs it reads."""
+def compile_function(spec: FunctionSpec, params: Argument, legs: str = "") -> Compiled:
+    """Eliminate common subexpressions of ``spec`` and record which inputs it reads; ``legs``:
+    the module's legs' letters (:attr:`~rpr3gen_derive.codegen.spec.ModuleSpec.legs`)."""
     flat = spec.flat_outputs()
     if spec.c_body is not None:  # a hand-written kernel body: nothing to eliminate
         return Compiled(spec, StraightLine((), (), 0, 0), (), (), tuple((o, k) for o, k, _ in flat))
     reserved = frozenset(str(s) for arg in (params, *spec.inputs) for s in arg.symbols)
     code = straight_line(
-        spec.program, [(f"{o}[{k}]", e) for o, k, e in flat], reserved, not spec.straight
+        spec.program,
+        [(f"{o}[{k}]", e) for o, k, e in flat],
+        reserved,
+        eliminate=not spec.straight,
+        legs=legs,
     )
     used = set().union(*(rhs.free_symbols for _, rhs in code.assignments + code.outputs))
     names = {str(s) for s in used}

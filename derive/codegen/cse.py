@@ -3,7 +3,7 @@
 The program's right-hand sides and a function's outputs are passed to ``sympy.cse`` together,
 in program order, with ``order="canonical"``; the result is a straight-line list of assignments
 in which every temporary comes right before its first use. Assignments that no output needs are
-dropped. The temporaries of one leg are then named after leg A's (:mod:`.legnames`).
+dropped. The temporaries of one leg are then named after the first leg's (:mod:`.legnames`).
 """
 
 from __future__ import annotations
@@ -60,11 +60,13 @@ def straight_line(
     outputs: Sequence[tuple[str, sp.Expr]],
     reserved: frozenset[str] = frozenset(),
     eliminate: bool = True,
+    legs: str = "",
 ) -> StraightLine:
     """Eliminate common subexpressions across ``program`` and the ``(label, expr)`` outputs;
     ``reserved``: names a renamed temporary must not take (the parameters', the inputs');
     ``eliminate`` False: the program is already free of them (as :mod:`.adjoint` writes it),
-    its live statements are kept as they are."""
+    its live statements are kept as they are; ``legs``: the module's legs' letters, whose
+    temporaries get per-leg names."""
     live = _live(program, outputs)
     exprs = [expr for _, expr in live] + [expr for _, expr in outputs]
     ops_before = count_ops(exprs)
@@ -93,6 +95,6 @@ def straight_line(
     for (name, _), expr in zip(outputs, reduced[len(live) :], strict=True):
         emit_temps_of(expr)
         result.append((name, expr))
-    lines, result = leg_names(lines, result, set(temp_defs), reserved)
+    lines, result = leg_names(lines, result, set(temp_defs), reserved, legs=legs)
     ops_after = count_ops([expr for _, expr in lines] + [expr for _, expr in result])
     return StraightLine(tuple(lines), tuple(result), ops_before, ops_after)

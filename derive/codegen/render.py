@@ -139,7 +139,7 @@ class Generator:
 
     def _render_module(self, module: ModuleSpec, digest: str) -> dict[str, str]:
         with self.stage("cse"):
-            compiled = [compile_function(f, module.params) for f in module.functions]
+            compiled = [compile_function(f, module.params, module.legs) for f in module.functions]
         files: dict[str, str] = {}
         roles: dict[str, str] = {}
         for backend in (python, c, graph):

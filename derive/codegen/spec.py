@@ -203,6 +203,12 @@ class ModuleSpec:
     ``(name, C literal, comment)``. ``tables`` are extra name tables (each an :class:`Argument`
     with a ``table``), for indices that no function's input or output names one by one (e.g.
     the columns of a matrix output).
+
+    ``legs`` are the letters of the robot's legs, in order (``"ABC"``, ``"ABCDEF"``): a leg's
+    symbols are named alike but for its letter at one place (``bx_A`` ... ``bx_F``), and the
+    engine names each leg's temporaries after the first leg's (:mod:`.legnames`) and runs the
+    legs' alike statements side by side (the C lanes, the NumPy backend's leg blocks). Empty
+    (the default) or one leg: nothing is shared between legs.
     """
 
     prefix: str
@@ -214,8 +220,13 @@ class ModuleSpec:
     thresholds: tuple[Threshold, ...] = ()
     defines: tuple[tuple[str, str, str], ...] = field(default_factory=tuple)
     tables: tuple[Argument, ...] = field(default_factory=tuple)
+    legs: str = ""
 
     def __post_init__(self) -> None:
+        if len(set(self.legs)) != len(self.legs) or not all(
+            leg.isascii() and leg.isupper() for leg in self.legs
+        ):
+            raise ValueError(f"legs must be distinct capital letters, not {self.legs!r}")
         if any(t.table is None for t in self.tables):
             raise ValueError("an extra name table needs a table name")
         codes = {c.name for c in self.return_codes}

@@ -449,6 +449,7 @@ def module(
             ("NUM_LEGS", str(len(structure.legs)), "legs"),
             ("DOF", str(structure.dof), "the platform's degrees of freedom (size of q)"),
         ),
+        legs=structure.legs,
     )
 
 

@@ -19,6 +19,7 @@ from functools import cache
 from rpr3gen_derive.codegen.spec import FunctionSpec, ModuleSpec, ReturnCode, Threshold
 from rpr3gen_derive.planar import control
 from rpr3gen_derive.planar import direct_kinematics as dk
+from rpr3gen_derive.planar.geometry import LEGS
 from rpr3gen_derive.planar.registry.arguments import params_argument
 from rpr3gen_derive.planar.registry.control_model import (
     actuator_coordinates,
@@ -175,4 +176,5 @@ def module(
         thresholds=thresholds(structure),
         tables=(inertial_parameters(structure),),
         defines=tuple(defines),
+        legs="".join(LEGS),
     )

@@ -82,11 +82,11 @@ def _kernel_lines(
     return schedule(lines)
 
 
-def _code(lines: list[Line], param_count: int, prefix: str) -> list[str]:
-    """A kernel's statements as C lines: its legs as lane loops (:mod:`.lanes`) when it has
-    enough statements to share them, else one statement after the other; a sine and a cosine
-    of one argument as one call (:mod:`.sincos`)."""
-    return sincos.pair(lanes(lines, param_count) or plain(lines), prefix)
+def _code(lines: list[Line], param_count: int, prefix: str, legs: str) -> list[str]:
+    """A kernel's statements as C lines: its legs (the module's letters) as lane loops
+    (:mod:`.lanes`) when it has enough statements to share them, else one statement after the
+    other; a sine and a cosine of one argument as one call (:mod:`.sincos`)."""
+    return sincos.pair(lanes(lines, param_count, legs) or plain(lines), prefix)
 
 
 def _needed(lines: list[Line]) -> list[Line]:
@@ -171,12 +171,14 @@ def _function(module: ModuleSpec, c: Compiled, values: bool = False) -> dict[str
             _kernel_lines(c, prefix, outputs(enumerate(e for _, e in c.code.outputs))),
             count,
             prefix,
+            module.legs,
         ),
         "values_lines": (
             _code(
                 _kernel_lines(c, prefix, outputs(enumerate(e for _, e in c.code.outputs)), True),
                 count,
                 prefix,
+                module.legs,
             )
             if values
             else None

@@ -47,7 +47,7 @@ def render(
                     "c": c,
                     "spec": c.spec,
                     "name": f"{module.prefix}_{c.spec.name}",
-                    "lowered": lower_numpy(c.code, inputs, params, rows, constants),
+                    "lowered": lower_numpy(c.code, inputs, params, rows, constants, module.legs),
                     "first_input": c.spec.inputs[0].name,
                     "sizes": {
                         o.name: table_count(o.table) if o.table else str(o.size)

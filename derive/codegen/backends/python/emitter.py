@@ -19,16 +19,19 @@ class LoweredNumpy:
 
     scalar_lines: list[str]
     vector_lines: list[str]
-    #: Work rows ``w0 ...``; three consecutive of them are also a (3, n) block (``triples``).
+    #: Work rows ``w0 ...``; ``legs`` consecutive of them are also a (legs, n) block
+    #: (``blocks``).
     buffers: int
     sincos: bool = False
     ufuncs: frozenset[str] = frozenset()
     atan2: bool = False
     #: Output rows whose sums the function writes into its ``sums`` argument (:func:`add_sums`).
     sums: int = 0
-    #: The first rows of the (3, n) blocks ``tK`` (rows K to K + 2) the legs' statements use
-    #: (:func:`leg_groups`).
-    triples: tuple[int, ...] = ()
+    #: The first rows of the (legs, n) blocks ``tK`` (rows K to K + legs - 1) the legs'
+    #: statements use (:func:`leg_groups`).
+    blocks: tuple[int, ...] = ()
+    #: The module's count of legs: the rows of a block.
+    legs: int = 0
 
 
 #: Work rows the module's ``_sincos(x, s, c, work)`` helper takes.
@@ -64,6 +67,8 @@ class _Lowering:
     """
 
     scalars: set[sp.Symbol]
+    #: The module's count of legs: the rows of a (legs, n) block.
+    legs: int = 0
     #: The module's number constants, shared by its functions: text -> name (``_K0`` ...).
     constants: dict[str, str] = field(default_factory=dict)
     #: This function's scalar operands of parameters: text -> name (``_k0`` ...).
@@ -76,12 +81,12 @@ class _Lowering:
     refs: dict[str, int] = field(default_factory=dict)
     count: int = 0
     lines: list[str] = field(default_factory=list)
-    #: Operand texts that hold the three legs: (3, n) blocks, (3, 1) parameter columns.
+    #: Operand texts that hold every leg: (legs, n) blocks, (legs, 1) parameter columns.
     stacked: set[str] = field(default_factory=set)
-    #: Parameter-only symbols that hold the three legs' values as a (3, 1) column.
+    #: Parameter-only symbols that hold the legs' values as a (legs, 1) column.
     stacked_scalars: set[sp.Symbol] = field(default_factory=set)
-    #: The first rows of the (3, n) blocks used (``t12``: rows 12 to 14).
-    triples: set[int] = field(default_factory=set)
+    #: The first rows of the (legs, n) blocks used (``t12``: rows 12 to 14 for three legs).
+    blocks: set[int] = field(default_factory=set)
 
     def is_scalar(self, expr: sp.Expr) -> bool:
         return expr.free_symbols <= self.scalars
@@ -90,7 +95,7 @@ class _Lowering:
         return operand in self.stacked
 
     def new(self, stacked: bool = False) -> str:
-        """A free work row ``wK``, or three consecutive ones ``tK`` (the legs' (3, n) block)."""
+        """A free work row ``wK``, or :attr:`legs` consecutive ones ``tK`` (the legs' block)."""
         if not stacked:
             if self.free:
                 index = min(self.free)
@@ -101,25 +106,26 @@ class _Lowering:
             name = f"w{index}"
         else:
             free = set(self.free)
-            found = next((k for k in sorted(free) if {k + 1, k + 2} <= free), None)
+            rest = range(1, self.legs)
+            found = next((k for k in sorted(free) if all(k + j in free for j in rest)), None)
             if found is None:  # grow: the free rows at the end, then new ones
                 found = self.count
                 while found - 1 in free:
                     found -= 1
-                self.count = max(self.count, found + 3)
+                self.count = max(self.count, found + self.legs)
             index = found
-            for k in range(index, index + 3):
+            for k in range(index, index + self.legs):
                 if k in free:
                     self.free.remove(k)
             name = f"t{index}"
             self.stacked.add(name)
-            self.triples.add(index)
+            self.blocks.add(index)
         self.temps.add(name)
         return name
 
     def _free_row(self, name: str) -> None:
         first = int(name[1:])
-        self.free.extend(range(first, first + 3) if name.startswith("t") else [first])
+        self.free.extend(range(first, first + self.legs) if name.startswith("t") else [first])
 
     def release(self, operand: str) -> None:
         """Free an anonymous temporary once it has been consumed."""
@@ -137,8 +143,8 @@ class _Lowering:
             self.refs[where] += 1
 
     def bind_legs(self, symbols: list[sp.Symbol], block: str) -> None:
-        """Give the three legs' symbols the rows of the (3, n) block ``block``: each row is
-        freed when its own leg's value is dead."""
+        """Give the legs' symbols the rows of the (legs, n) block ``block``: each row is freed
+        when its own leg's value is dead."""
         self.temps.discard(block)
         first = int(block[1:])
         for leg, symbol in enumerate(symbols):

@@ -1,5 +1,5 @@
-"""The NumPy lowering's leg groups: the three legs' statements that are one expression, run
-as one call on a (3, n) block (:func:`leg_groups`), and the units they are placed by
+"""The NumPy lowering's leg groups: the legs' statements that are one expression, run as one
+call on a (legs, n) block (:func:`leg_groups`), and the units they are placed by
 (:func:`_units`)."""
 
 from __future__ import annotations
@@ -8,15 +8,16 @@ import heapq
 
 import sympy as sp
 from rpr3gen_derive.codegen.backends.python.sums import ROW_PATTERN
-from rpr3gen_derive.codegen.legnames import LEGS, leg_family, shape
+from rpr3gen_derive.codegen.legnames import leg_family, shape
 
+#: Fewest leg groups that make a function's statements worth lowering on (legs, n) blocks.
 MIN_GROUPS = 4
 
 
-def _fits(three: dict[int, sp.Symbol], alias: dict[sp.Symbol, str]) -> bool:
-    """A group's members are no outputs, or outputs in three consecutive rows of one array in
-    the legs' order (written at once: ``out[3:6]``)."""
-    rows = [alias.get(three[leg]) for leg in range(len(LEGS))]
+def _fits(each: dict[int, sp.Symbol], alias: dict[sp.Symbol, str]) -> bool:
+    """A group's members are no outputs, or outputs in consecutive rows of one array in the
+    legs' order (written at once: ``out[3:6]``)."""
+    rows = [alias.get(each[leg]) for leg in range(len(each))]
     if all(r is None for r in rows):
         return True
     found = [ROW_PATTERN.match(r) if r else None for r in rows]
@@ -24,25 +25,29 @@ def _fits(three: dict[int, sp.Symbol], alias: dict[sp.Symbol, str]) -> bool:
         return False
     names = {m[1] for m in found if m}
     starts = [int(m[2]) for m in found if m]
-    return len(names) == 1 and starts == list(range(starts[0], starts[0] + len(LEGS)))
+    return len(names) == 1 and starts == list(range(starts[0], starts[0] + len(each)))
 
 
 def leg_groups(
     statements: list[tuple[sp.Symbol, sp.Expr]],
     scalars: set[sp.Symbol],
     alias: dict[sp.Symbol, str],
+    legs: str,
 ) -> dict[sp.Symbol, tuple[int, int, bool]]:
-    """The legs' statements that one call can evaluate for the three legs at once: each
-    member's symbol -> (its group, its leg, whether the group is per-sample).
+    """The legs' statements that one call can evaluate for every leg of ``legs`` (the module's
+    letters) at once: each member's symbol -> (its group, its leg, whether the group is
+    per-sample).
 
-    A group is three symbols, one per leg, named alike but for the leg's letter
+    A group is one symbol per leg, named alike but for the leg's letter
     (:func:`~rpr3gen_derive.codegen.legnames.leg_family`): the legs' parameters, parameter-only
     statements, then, to a fixed point, per-sample statements whose right-hand sides are one
     expression once each member they read is read as its group (the same tree, as SymPy keeps
     it: the same operations on the same operands; compared by
     :func:`~rpr3gen_derive.codegen.legnames.shape`). Such statements give each leg the same bits
     as one statement each. None when there are fewer than :data:`MIN_GROUPS` per-sample
-    groups."""
+    groups, or fewer than two legs."""
+    if len(legs) < 2:
+        return {}
     names = {str(x): x for x in scalars} | {str(lhs): lhs for lhs, _ in statements}
     scalar = set(scalars)
     for lhs, rhs in statements:
@@ -51,10 +56,10 @@ def leg_groups(
     member: dict[sp.Symbol, tuple[int, int, bool]] = {}
     count = 0
     for name in sorted(names):
-        family = leg_family(name, names.keys())
+        family = leg_family(name, names.keys(), legs)
         if family is None:
             continue
-        per_leg = [names[family[0] + leg + family[1]] for leg in LEGS]
+        per_leg = [names[family[0] + leg + family[1]] for leg in legs]
         if all(x in scalar for x in per_leg):
             for leg, x in enumerate(per_leg):
                 member[x] = (count, leg, False)
@@ -77,21 +82,21 @@ def leg_groups(
                 continue
             if joined is None or not joined.isdisjoint(free):
                 read = [x for x in free if x in member]
-                legs = {member[x][1] for x in read}
+                of = {member[x][1] for x in read}
                 keys[lhs] = (
-                    (shape(rhs, {x: member[x][0] for x in read}), legs.pop())
-                    if len(legs) == 1
+                    (shape(rhs, {x: member[x][0] for x in read}), of.pop())
+                    if len(of) == 1
                     else None
                 )
             entry = keys[lhs]
             if entry is not None:
                 found.setdefault(entry[0], {}).setdefault(entry[1], lhs)
-        complete = [t for t in found.values() if len(t) == len(LEGS) and _fits(t, alias)]
+        complete = [t for t in found.values() if len(t) == len(legs) and _fits(t, alias)]
         if not complete:
             break
         joined = set()
-        for three in complete:
-            for leg, x in three.items():
+        for each in complete:
+            for leg, x in each.items():
                 member[x] = (count, leg, True)
                 joined.add(x)
             count += 1
@@ -102,7 +107,7 @@ def leg_groups(
 def _units(
     statements: list[tuple[sp.Symbol, sp.Expr]], member: dict[sp.Symbol, tuple[int, int, bool]]
 ) -> list[list[tuple[sp.Symbol, sp.Expr]]]:
-    """The statements as units: a per-sample group's three (in the legs' order) or one alone,
+    """The statements as units: a per-sample group's (in the legs' order) or one alone,
     each unit after those it reads, otherwise in the order of its first statement."""
     unit_of: dict[int, object] = {}
     members: dict[object, list[int]] = {}

@@ -23,9 +23,10 @@ dynamics. ``atan2`` is the module's ``_atan2`` (``numpy.arctan`` of the quotient
 quadrant's multiple of pi: ~12 ns a value where ``numpy.arctan2`` costs ~20), ``sin`` and ``cos``
 of one argument its ``_sincos``.
 
-The three legs' statements that are one expression (:func:`leg_groups`, as the C's lanes) run as
-one call each operation on a (3, n) block of three consecutive work rows (``t12``: rows 12 to
-14), the legs' parameters as a (3, 1) column; a group is placed where its first statement was,
+The legs' statements that are one expression (:func:`leg_groups`, as the C's lanes) run as one
+call each operation on a (legs, n) block of consecutive work rows (``t12``: rows 12 to 14 for
+three legs, to 17 for six), the legs' parameters as a (legs, 1) column; the legs are the
+module's (``legs``: ``ABC``, ``ABCDEF``). A group is placed where its first statement was,
 after what it reads (:func:`_units`), and each leg's row is freed when that leg's value is dead.
 The inverse dynamics makes ~40 % fewer calls (602 to 370, prismatic): 5 % less time at 10^4
 samples, the same at 10^5 (docs/performance-log.md). The values are each leg's own, the terms of a
@@ -58,11 +59,12 @@ def lower_numpy(
     params: set[sp.Symbol],
     output_rows: dict[str, str],
     constants: dict[str, str] | None = None,
+    legs: str = "",
 ) -> LoweredNumpy:
     """Lower ``code`` given where inputs live (``{x: "x"}``) and each output's row text.
 
     ``constants``: the module's number constants so far (text -> name), added to in place, so
-    that the module's functions share them."""
+    that the module's functions share them; ``legs``: the module's legs' letters."""
     statements, outputs = fold_copies(code, params)
     statements, outputs = fold_signs(statements, outputs, set(params))
     # Output rows: an output that is a named intermediate is computed in place.
@@ -70,7 +72,7 @@ def lower_numpy(
     for name, expr in outputs:
         if expr.is_Symbol and expr not in alias and expr not in inputs:
             alias[expr] = output_rows[name]
-    member = leg_groups(statements, set(params), alias)
+    member = leg_groups(statements, set(params), alias, legs)
     units = _units(statements, member)
     uses: dict[sp.Symbol, int] = {}  # index of each symbol's last use (by unit)
     for index, unit in enumerate(units):
@@ -80,7 +82,9 @@ def lower_numpy(
     for _, expr in outputs:  # read by an output: alive to the end
         for sym in expr.free_symbols:
             uses[sym] = len(units)
-    state = _Lowering(scalars=set(params), constants={} if constants is None else constants)
+    state = _Lowering(
+        scalars=set(params), legs=len(legs), constants={} if constants is None else constants
+    )
     state.location.update(inputs)
     scalar_lines: list[str] = []
     rhs_of = dict(statements)
@@ -89,22 +93,22 @@ def lower_numpy(
         for a, b in trig_pairs(statements).items()
         if a not in alias and b not in alias and not state.is_scalar(rhs_of[a])
     }
-    stacked: dict[int, sp.Symbol] = {}  # a group -> the symbol of its three legs at once
+    stacked: dict[int, sp.Symbol] = {}  # a group -> the symbol of its legs at once
 
     def group_symbol(x: sp.Symbol) -> sp.Symbol:
         g, _, per_sample = member[x]
         if g not in stacked:
             stacked[g] = sp.Symbol(f"_legs{g}", real=True)
-            if not per_sample:  # the legs' parameters as a (3, 1) column
-                three = sorted((y for y in member if member[y][0] == g), key=lambda y: member[y][1])
-                column = ", ".join(f"[{y}]" for y in three)
+            if not per_sample:  # the legs' parameters as a (legs, 1) column
+                each = sorted((y for y in member if member[y][0] == g), key=lambda y: member[y][1])
+                column = ", ".join(f"[{y}]" for y in each)
                 scalar_lines.append(f"{stacked[g]} = numpy.array([{column}], numpy.float64)")
                 state.scalars.add(stacked[g])
                 state.stacked_scalars.add(stacked[g])
         return stacked[g]
 
     for index, unit in enumerate(units):
-        if len(unit) > 1:  # the three legs' statements, in one call each operation
+        if len(unit) > 1:  # the legs' statements, in one call each operation
             lhs, rhs = unit[0]
             read = sorted((x for x in rhs.free_symbols if x in member), key=str)
             rhs = rhs.xreplace({x: group_symbol(x) for x in read})
@@ -167,11 +171,12 @@ def lower_numpy(
     summed = list(dict.fromkeys(output_rows.values()))
     return LoweredNumpy(
         scalar_lines,
-        hoisted + add_sums(state.lines, summed),
+        hoisted + add_sums(state.lines, summed, len(legs)),
         state.count,
         bool(pairs),
         frozenset(state.ufuncs | {"add"}),
         state.atan2,
         len(summed),
-        tuple(sorted(state.triples)),
+        tuple(sorted(state.blocks)),
+        len(legs),
     )

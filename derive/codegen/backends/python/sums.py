@@ -5,12 +5,11 @@ from __future__ import annotations
 
 import re
 
-from rpr3gen_derive.codegen.legnames import LEGS
 
-
-def add_sums(lines: list[str], rows: list[str]) -> list[str]:
+def add_sums(lines: list[str], rows: list[str], legs: int) -> list[str]:
     """``lines`` with ``sums[k] = _add.reduce(row)`` after the last line that names output row
-    ``rows[k]`` (at the end for a row no line names).
+    ``rows[k]`` (at the end for a row no line names); ``legs`` rows of one array at once where
+    they come in a run (``legs``: the module's count of legs).
 
     The runtime's failure checks must know whether every output is finite. Read again after the
     kernel, a block's outputs come from the outer caches or memory: ~50 ns a sample of the
@@ -34,9 +33,9 @@ def add_sums(lines: list[str], rows: list[str]) -> list[str]:
     found = []
     for index, line in enumerate(lines):
         found.append(line)
-        found += _sum_lines(after.get(index, []), rows)
+        found += _sum_lines(after.get(index, []), rows, legs)
     if not lines:
-        found += _sum_lines(list(range(len(rows))), rows)
+        found += _sum_lines(list(range(len(rows))), rows, legs)
     return found
 
 
@@ -44,9 +43,9 @@ _SLICE = re.compile(r"(?<![\w.])(\w+)\[(\d+):(\d+)\]")
 ROW_PATTERN = re.compile(r"^(\w+)\[(\d+)\]$")
 
 
-def _sum_lines(ks: list[int], rows: list[str]) -> list[str]:
-    """``sums[k] = _add.reduce(row)`` for each k; three consecutive rows of one array with
-    consecutive ``k`` (a leg triple's) in one call along their rows."""
+def _sum_lines(ks: list[int], rows: list[str], legs: int) -> list[str]:
+    """``sums[k] = _add.reduce(row)`` for each k; ``legs`` consecutive rows of one array with
+    consecutive ``k`` (a leg group's, for two legs or more) in one call along their rows."""
     lines, k = [], 0
     ks = sorted(ks)
     while k < len(ks):
@@ -57,8 +56,8 @@ def _sum_lines(ks: list[int], rows: list[str]) -> list[str]:
             if not nxt or nxt[1] != first[1] or int(nxt[2]) != int(first[2]) + run:
                 break
             run += 1
-        if run >= len(LEGS) and first:
-            run = len(LEGS)
+        if legs > 1 and run >= legs and first:
+            run = legs
             rows_text = f"{first[1]}[{first[2]}:{int(first[2]) + run}]"
             lines.append(f"_add.reduce({rows_text}, 1, None, sums[{ks[k]}:{ks[k] + run}])")
         else:
@@ -66,6 +65,3 @@ def _sum_lines(ks: list[int], rows: list[str]) -> list[str]:
             lines.append(f"sums[{ks[k]}] = _add.reduce({rows[ks[k]]})")
         k += run
     return lines
-
-
-#: Fewest leg groups that make a function's statements worth lowering on (3, n) blocks.
