@@ -234,51 +234,10 @@ def _spatial(
 def _unit_columns(
     variant: Variant, params: Any, sqrt: Callable[[Any], Any]
 ) -> list[tuple[str, dict[int, Any]]]:
-    """:func:`rpr3gen.spatial_inertia.unit_columns` on symbolic ``params``: per column of
-    ``Y``, its role and the components of ``params`` it replaces."""
+    """:func:`rpr3gen.spatial_inertia.unit_edits` of ``variant`` on symbolic ``params``."""
     kinds = variant.defines["LEG"].strip('"')
     legs = "ABCDEF"[: int(variant.defines["NUM_LEGS"])]
-    index = {n: i for i, n in enumerate(variant.param_names)}
-    base = {index[n]: 0.0 for n in spatial_inertia.zeroed(kinds, legs)}
-    out: list[tuple[str, dict[int, Any]]] = []
-    for b in spatial_inertia.bodies(kinds, legs):
-        p = dict(base)
-        p[index[b.mass]] = 1.0
-        if b.rod:
-            assert b.reference is not None
-            assert b.tip is not None
-            fr, ir = index[b.com[0]], index[b.inertia[0]]
-            squares = [
-                (params[index[t]] - params[index[r]]) * (params[index[t]] - params[index[r]])
-                for t, r in zip(b.tip, b.reference, strict=True)
-            ]
-            length = sqrt(squares[0] + squares[1] + squares[2])
-            p[fr] = 0.0
-            out.append(("mass", dict(p)))
-            p[fr], p[ir] = 1.0 / length, -1.0
-            out.append(("moment", dict(p)))
-            p[index[b.mass]], p[fr], p[ir] = 0.0, 0.0, 1.0
-            out.append(("plain", dict(p)))
-            continue
-        ref = [params[index[r]] for r in b.reference] if b.reference else [0.0, 0.0, 0.0]
-        com = [index[c] for c in b.com]
-        inertia = [index[i] for i in b.inertia]
-        for a in range(3):
-            p[com[a]] = ref[a]
-        out.append(("mass", dict(p)))
-        for a in range(3):
-            q = dict(p)
-            q[com[a]] = ref[a] + 1.0
-            for d in range(3):
-                if d != a:
-                    q[inertia[d]] = -1.0
-            out.append(("moment", q))
-        p[index[b.mass]] = 0.0
-        for e in range(6):
-            q = dict(p)
-            q[inertia[e]] = 1.0
-            out.append(("plain", q))
-    return out
+    return spatial_inertia.unit_edits(kinds, legs, variant.param_names, params, sqrt)
 
 
 def _forward_kinematics(

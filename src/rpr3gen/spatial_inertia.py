@@ -11,12 +11,21 @@ inverse dynamics at the model numbers :func:`unit_columns` gives, one per column
 
 from __future__ import annotations
 
-from collections.abc import Iterator, Mapping, Sequence
+import math
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
-__all__ = ["Body", "bodies", "inertial_parameters", "parameter_names", "unit_columns"]
+__all__ = [
+    "Body",
+    "bodies",
+    "inertial_parameters",
+    "parameter_names",
+    "unit_columns",
+    "unit_edits",
+]
 
 _ENTRIES = ("xx", "yy", "zz", "xy", "xz", "yz")
 BODY_QUANTITIES: tuple[str, ...] = ("m", "mcx", "mcy", "mcz", *(f"I{e}" for e in _ENTRIES))
@@ -133,44 +142,68 @@ def zeroed(kinds: str, legs: str) -> tuple[str, ...]:
     return tuple(out)
 
 
-def unit_columns(
-    kinds: str, legs: str, names: Sequence[str], params: np.ndarray
-) -> Iterator[tuple[np.ndarray, str]]:
-    """For each column ``j`` of ``Y`` in order: the parameter vector (``names``' order) whose
-    ``pi`` is ``e_j``, and its role: ``"mass"`` (a body's mass column), ``"moment"`` (a first
+def unit_edits(
+    kinds: str,
+    legs: str,
+    names: Sequence[str],
+    params: Any,
+    sqrt: Callable[[Any], Any] = math.sqrt,
+) -> list[tuple[str, dict[int, Any]]]:
+    """For each column ``j`` of ``Y`` in order: its role and the components of the parameter
+    vector (``names``' order; ``params`` numeric or symbolic, ``sqrt`` of its kind) to replace
+    so that ``pi`` is ``e_j``. Roles: ``"mass"`` (a body's mass column), ``"moment"`` (a first
     moment: ``pi`` is ``e_j`` plus the body's mass, so the column is the efforts less the mass
     column) or ``"plain"``. Gravity is the model's; every other body is massless."""
     index = {n: i for i, n in enumerate(names)}
-    base = np.array(params, dtype=float)
-    for n in zeroed(kinds, legs):
-        base[index[n]] = 0.0
+    base = {index[n]: 0.0 for n in zeroed(kinds, legs)}
+    out: list[tuple[str, dict[int, Any]]] = []
     for b in bodies(kinds, legs):
-        p = base.copy()
+        p = dict(base)
         p[index[b.mass]] = 1.0
         if b.rod:
+            assert b.reference is not None
+            assert b.tip is not None
             fr, ir = index[b.com[0]], index[b.inertia[0]]
-            length = _rod_length(b, dict(zip(names, params, strict=True)))
+            squares = [
+                (params[index[t]] - params[index[r]]) * (params[index[t]] - params[index[r]])
+                for t, r in zip(b.tip, b.reference, strict=True)
+            ]
+            length = sqrt(squares[0] + squares[1] + squares[2])
             p[fr] = 0.0
-            yield p.copy(), "mass"
+            out.append(("mass", dict(p)))
             p[fr], p[ir] = 1.0 / length, -1.0
-            yield p.copy(), "moment"
+            out.append(("moment", dict(p)))
             p[index[b.mass]], p[fr], p[ir] = 0.0, 0.0, 1.0
-            yield p.copy(), "plain"
+            out.append(("plain", dict(p)))
             continue
         ref = [params[index[r]] for r in b.reference] if b.reference else [0.0, 0.0, 0.0]
         com = [index[c] for c in b.com]
         inertia = [index[i] for i in b.inertia]
-        p[com] = ref
-        yield p.copy(), "mass"
         for a in range(3):
-            q = p.copy()
+            p[com[a]] = ref[a]
+        out.append(("mass", dict(p)))
+        for a in range(3):
+            q = dict(p)
             q[com[a]] = ref[a] + 1.0
             for d in range(3):
                 if d != a:
                     q[inertia[d]] = -1.0
-            yield q, "moment"
+            out.append(("moment", q))
         p[index[b.mass]] = 0.0
         for e in range(6):
-            q = p.copy()
+            q = dict(p)
             q[inertia[e]] = 1.0
-            yield q, "plain"
+            out.append(("plain", q))
+    return out
+
+
+def unit_columns(
+    kinds: str, legs: str, names: Sequence[str], params: np.ndarray
+) -> Iterator[tuple[np.ndarray, str]]:
+    """:func:`unit_edits` applied to a copy of the numeric ``params``: each column's parameter
+    vector and its role."""
+    for role, edits in unit_edits(kinds, legs, names, params):
+        p = np.array(params, dtype=float)
+        for k, v in edits.items():
+            p[k] = v
+        yield p, role
