@@ -11,7 +11,7 @@ from PIL import Image
 import rpr3gen
 from rpr3gen import animation
 from rpr3gen.cli import main
-from rpr3gen.errors import InputError, Rpr3genError
+from rpr3gen.errors import InputError, TrajectoryError
 
 ROOT = Path(__file__).resolve().parent.parent
 SIZE = (480, 320)
@@ -167,7 +167,7 @@ def test_write_is_atomic(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Non
 def test_refuses_a_singular_pose(tmp_path: Path) -> None:
     model = rpr3gen.load_model(ROOT / "models" / "rrr.toml")
     traj = rpr3gen.paper_trajectory("rotation")  # through a parallel singularity at 1.49 s
-    with pytest.raises(Rpr3genError, match="conditioning"):
+    with pytest.raises(TrajectoryError, match="conditioning"):
         animation.write_animation(model, traj, tmp_path / "x.gif", fps=FPS, size=SIZE)
     assert list(tmp_path.iterdir()) == []
 

@@ -77,6 +77,16 @@ def test_failure_leaves_existing_file_unchanged(tmp_path: Path, error: type[Base
     assert leftovers(tmp_path, {"out.bin"}) == []
 
 
+def test_the_package_s_os_error_in_the_block_is_kept(tmp_path: Path) -> None:
+    """A SetupError (an OSError with no file: no C compiler...) raised while the file is written
+    reaches the caller as it is, not reworded as a failure to write the file."""
+    path = tmp_path / "out.bin"
+    with pytest.raises(rpr3gen.SetupError) as info, atomic_write(path, "wb"):
+        raise rpr3gen.SetupError("the c backend needs a C compiler")
+    assert str(info.value) == "the c backend needs a C compiler"
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_failure_creates_no_file(tmp_path: Path) -> None:
     path = tmp_path / "new.txt"
     with pytest.raises(BoomError):

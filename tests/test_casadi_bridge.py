@@ -169,5 +169,5 @@ def test_wrong_model_type_is_one_error() -> None:
 def test_missing_casadi_names_the_extra(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setitem(sys.modules, "casadi", None)  # import casadi now raises ImportError
     monkeypatch.setattr(rc, "_BUILT", {})
-    with pytest.raises(rpr3gen.Rpr3genError, match=r"pip install 'rpr3gen\[casadi\]'"):
+    with pytest.raises(rpr3gen.SetupError, match=r"pip install 'rpr3gen\[casadi\]'"):
         rc.function(rpr3gen.load_model(), "inverse_dynamics")

@@ -256,7 +256,7 @@ def test_resuming_another_grid_is_refused(tmp_path: Path, monkeypatch: pytest.Mo
         rpr3gen.sweep(None, GRID, out=out, workers=0, **OPTIONS)
     monkeypatch.undo()
     other = {**GRID, "mass.m3": [3.0, 4.0]}
-    with pytest.raises(rpr3gen.Rpr3genError, match="holds the chunks of another sweep"):
+    with pytest.raises(rpr3gen.SetupError, match="holds the chunks of another sweep"):
         rpr3gen.sweep(None, other, out=out, workers=0, resume=True, **OPTIONS)
     table = rpr3gen.sweep(None, GRID, out=out, workers=0, resume=True, **OPTIONS)
     assert table.num_rows == 9
@@ -313,7 +313,7 @@ def test_a_failed_task_is_one_line() -> None:
         def result(self) -> Any:
             raise RuntimeError("worker tcp://10.0.0.7:4321 died")
 
-    with pytest.raises(rpr3gen.Rpr3genError) as caught:
+    with pytest.raises(rpr3gen.SetupError) as caught:
         cluster.task_result(Lost())
     assert str(caught.value) == (
         "a sweep task failed on the Dask cluster: RuntimeError: worker tcp://10.0.0.7:4321 died"

@@ -6,7 +6,10 @@ are drawn from each argument's :class:`~hostile_kinds.Kind`: values of the wrong
 (``InputTypeError``), bad values and shapes (``InputError``, or the function's own class),
 good values (the same answer as the plain float64 array), arrays of different lengths, NaN
 rows, empty and one-row inputs; then Hypothesis draws any value for any argument and checks
-the outcome against the kind's oracle. A new function joins by adding its row.
+the outcome against the kind's oracle. A new function joins by adding its row. Every refusal is
+of the families docs/errors.md promises (issue 51): a ``TypeError`` for a wrong type, a
+``ValueError`` (or, for the environment, such as a folder without generated code, an
+``OSError``) for a bad value; never the bare ``Rpr3genError``.
 
 The rows are a function of a :class:`Scene`: a robot, a motion it follows and every other input
 derived from the runtime. Every row that takes a model runs on each scene: the paper's robot,
@@ -61,6 +64,7 @@ import rpr3gen
 import rpr3gen.casadi
 import rpr3gen.jax
 from rpr3gen.errors import (
+    GeneratedCodeError,
     GridError,
     IdentificationError,
     InputError,
@@ -538,7 +542,9 @@ GENERATED = Kind(
     lambda v: None if isinstance(v, str | Path) else "type",
     wrong_types=(5, b"gen", ["gen"]),
     bad_values=(Where("missing", lambda tmp: str(tmp / "nothing")), ""),
-    value_error=Rpr3genError,  # the environment: a plain Rpr3genError (docs/errors.md)
+    # An empty name is a bad value; a folder without the generated code is the environment's
+    # (an OSError, docs/errors.md).
+    value_error=(InputError, GeneratedCodeError),
 )
 NAME = Kind(
     "trajectory name",
@@ -1135,11 +1141,15 @@ APIS: tuple[Api, ...] = tuple(table("paper").values())
 REFUSALS: dict[str, tuple[type[Exception], ...]] = {
     "identify": (InputError, IdentificationError),
     "excite": (IdentificationError,),
-    "SampleEvaluator.evaluate": (Rpr3genError,),
+    "SampleEvaluator.evaluate": (InputError,),
     "Trajectory.from_positions": (TrajectoryError,),
     "Trajectory": (TrajectoryError,),
     "retime": (InputError, TrajectoryError),
 }
+
+#: The standard families every error of the package belongs to (docs/errors.md): a bad value,
+#: a wrong type, the environment. A bare Rpr3genError is none of them.
+FAMILIES = (ValueError, TypeError, OSError)
 
 EXEMPT = {
     "BACKENDS": "a constant",
@@ -1161,6 +1171,26 @@ def test_every_public_name_has_a_row() -> None:
     }
     missing = set(rpr3gen.__all__) - rowed - set(EXEMPT) - errors
     assert not missing, f"add a row to APIS for {sorted(missing)}"
+
+
+def _classes(promised: type[Exception] | tuple[type[Exception], ...]) -> tuple[type, ...]:
+    return promised if isinstance(promised, tuple) else (promised,)
+
+
+@pytest.mark.parametrize("where", SCENES)
+def test_every_promised_error_is_of_a_family(where: str) -> None:
+    """What the rows promise for a bad value, and REFUSALS, name classes of the families
+    (a ValueError or an OSError, never the bare base class)."""
+    promised = {
+        f"{api.name}({name})": _classes(kind.value_error)
+        for api in table(where).values()
+        for name, kind in api.kinds.items()
+    } | {f"{name} (a refusal)": classes for name, classes in REFUSALS.items()}
+    bare = {
+        k: [c.__name__ for c in classes if not issubclass(c, ValueError | OSError)]
+        for k, classes in promised.items()
+    }
+    assert not {k: v for k, v in bare.items() if v}
 
 
 # -- the cases ------------------------------------------------------------------------------
@@ -1227,6 +1257,7 @@ def test_a_wrong_type_is_an_input_type_error_naming_it(
     def check(value: Any) -> None:
         with pytest.raises(InputTypeError) as info:
             _call(api, tmp_path, **{name: value})
+        assert isinstance(info.value, TypeError), repr(info.value)
         _assert_names(info.value, name)
 
     _every(api.kinds[name].wrong_types, check)
@@ -1243,7 +1274,7 @@ def test_a_bad_value_is_the_promised_error_naming_it(
             _call(api, tmp_path, **{name: value})
         assert isinstance(info.value, api.kinds[name].value_error), repr(info.value)
         assert not isinstance(info.value, InputTypeError), repr(info.value)
-        assert isinstance(info.value, ValueError) or type(info.value) is Rpr3genError
+        assert isinstance(info.value, ValueError | OSError), repr(info.value)
         shown = resolve(value, tmp_path)
         _assert_names(info.value, name, *([shown] if isinstance(shown, str) and shown else []))
 
@@ -1518,11 +1549,13 @@ def test_any_value_is_taken_or_refused_as_promised(
             _same(result, _call(api, tmp, **{name: np.array(value, dtype=float)}))
         return
     assert "\n" not in str(refused), str(refused)
+    assert isinstance(refused, FAMILIES), repr(refused)
     if verdict == "type":
         assert isinstance(refused, InputTypeError), repr(refused)
         _assert_names(refused, name)
     elif verdict == "value":
         assert isinstance(refused, api.kinds[name].value_error), repr(refused)
+        assert isinstance(refused, ValueError | OSError), repr(refused)
         assert not isinstance(refused, InputTypeError), repr(refused)
         _assert_names(refused, name)
     else:

@@ -609,7 +609,7 @@ def test_a_damaged_generated_folder_is_one_line_naming_the_file_and_the_fix(
     for argv in (["simulate", "--samples", "5"], ["fk", "0.1", "0", "0"]):
         err = refused([argv[0], "--generated", str(folder), *argv[1:]], capsys, expected)
         assert f"rpr3gen generate --out {folder}" in err, err
-    with pytest.raises(rpr3gen.Rpr3genError, match="rpr3gen generate --out") as info:
+    with pytest.raises(rpr3gen.GeneratedCodeError, match="rpr3gen generate --out") as info:
         rpr3gen.load_model(generated=folder)
     assert "\n" not in str(info.value)
 

@@ -149,7 +149,7 @@ def test_unknown_function_and_wrong_types_are_one_error() -> None:
 
 def test_missing_jax_names_the_extra(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setitem(sys.modules, "jax", None)  # import jax now raises ImportError
-    with pytest.raises(rpr3gen.Rpr3genError, match=r"pip install 'rpr3gen\[jax\]'"):
+    with pytest.raises(rpr3gen.SetupError, match=r"pip install 'rpr3gen\[jax\]'"):
         rj.function(rpr3gen.load_model(), "inverse_dynamics")
 
 

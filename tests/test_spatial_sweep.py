@@ -307,7 +307,7 @@ def test_an_interrupted_sweep_resumes_and_loses_nothing(
         return evaluate_chunk(plan, index)
 
     monkeypatch.setattr(sweeps, "evaluate_chunk", counted)
-    with pytest.raises(rpr3gen.Rpr3genError, match="holds the chunks of another sweep"):
+    with pytest.raises(rpr3gen.SetupError, match="holds the chunks of another sweep"):
         rpr3gen.sweep(DELTA, grid, [DELTA_MOTION], out=out, resume=True, backend="c", **options)
     rpr3gen.sweep(DELTA, grid, [DELTA_MOTION], out=out, resume=True, **options)
     assert evaluated == [1, 2]

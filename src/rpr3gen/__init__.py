@@ -31,6 +31,7 @@ from rpr3gen.control import (
 )
 from rpr3gen.design import WorkspaceMap, sweep, workspace, write_workspace
 from rpr3gen.errors import (
+    GeneratedCodeError,
     GridError,
     IdentificationError,
     IdentificationWarning,
@@ -39,6 +40,7 @@ from rpr3gen.errors import (
     ModelError,
     Rpr3genError,
     Rpr3genWarning,
+    SetupError,
     TrajectoryError,
     TrajectoryWarning,
 )
@@ -65,6 +67,7 @@ __all__ = [
     "INERTIAL_PARAMETER_NAMES",
     "OUTPUT_NAMES",
     "PARAM_NAMES",
+    "GeneratedCodeError",
     "GridError",
     "IdentificationError",
     "IdentificationWarning",
@@ -75,6 +78,7 @@ __all__ = [
     "Rpr3genError",
     "Rpr3genWarning",
     "SampleEvaluator",
+    "SetupError",
     "Trajectory",
     "TrajectoryError",
     "TrajectoryWarning",

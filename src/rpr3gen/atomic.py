@@ -16,7 +16,7 @@ from typing import IO, Any
 
 import numpy as np
 
-from rpr3gen.errors import InputError
+from rpr3gen.errors import InputError, Rpr3genError
 
 __all__ = ["atomic_path", "atomic_write", "write_csv_table", "write_results_csv"]
 
@@ -105,7 +105,9 @@ def _replacing(tmp: str, target: str, path: str | os.PathLike[str]) -> Iterator[
     except BaseException as exc:
         with contextlib.suppress(OSError):
             os.unlink(tmp)
-        if isinstance(exc, OSError) and exc.filename in (None, tmp):
+        # The package's own OSErrors (a SetupError: no compiler...) are not about the file.
+        own = isinstance(exc, Rpr3genError)
+        if not own and isinstance(exc, OSError) and exc.filename in (None, tmp):
             raise _about(exc, path) from exc
         raise
     _fsync_folder(os.path.dirname(target))

@@ -3,7 +3,7 @@ name, checked, with its variant and generated graph module (docs/bridges.md).
 
 Bad input is one line each: a model of the wrong type (:class:`~rpr3gen.errors.InputTypeError`,
 by the caller's ``checked``), a name no bridge offers (:class:`~rpr3gen.errors.InputError`,
-with the names it does offer), a missing extra (:class:`~rpr3gen.errors.Rpr3genError`, with the
+with the names it does offer), a missing extra (:class:`~rpr3gen.errors.SetupError`, with the
 ``pip install`` that brings it).
 """
 
@@ -13,7 +13,7 @@ from dataclasses import dataclass
 from types import ModuleType
 
 from rpr3gen import graph_compose
-from rpr3gen.errors import InputError, Rpr3genError, did_you_mean
+from rpr3gen.errors import InputError, SetupError, did_you_mean
 from rpr3gen.loader import graph_module
 from rpr3gen.manifest import FunctionInfo, Variant
 
@@ -47,12 +47,12 @@ def target(variant: Variant, name: str) -> Target:
     return Target(variant, variant.function(name), graph_module(variant))
 
 
-def missing_extra(package: str, extra: str, error: ImportError) -> Rpr3genError:
+def missing_extra(package: str, extra: str, error: ImportError) -> SetupError:
     """The one-line error of a bridge whose package is not installed (re-raises any other
     import error)."""
     if (error.name or "").split(".")[0] != package:
         raise error
-    return Rpr3genError(
+    return SetupError(
         f"this needs {package}, which is not installed: install the extra '{extra}': "
         f"pip install 'rpr3gen[{extra}]'"
     )

@@ -138,7 +138,7 @@ def function(model: Model, name: str) -> Any:
     Raises:
         InputError: no such function in the bridge (the message lists those there are).
         InputTypeError: ``model`` is not a :class:`rpr3gen.Model`, or ``name`` not a string.
-        Rpr3genError: CasADi is not installed (``pip install 'rpr3gen[casadi]'``).
+        SetupError: CasADi is not installed (``pip install 'rpr3gen[casadi]'``).
     """
     return _function(variants.load(model.structure, model.generated), name)
 

@@ -38,7 +38,7 @@ try:
 except ImportError:  # pragma: no cover - Windows: atomic renames only
     fcntl = None  # type: ignore[assignment]
 
-from rpr3gen.errors import Rpr3genError
+from rpr3gen.errors import SetupError
 from rpr3gen.loader import check_files
 from rpr3gen.manifest import Variant
 
@@ -106,7 +106,7 @@ def cache_dir() -> Path:
 def _compiler() -> list[str]:
     command = shlex.split(os.environ.get("CC", "cc"))
     if not command or shutil.which(command[0]) is None:
-        raise Rpr3genError(
+        raise SetupError(
             f"the c backend needs a C compiler, and {command[0] if command else 'cc'!r} was not "
             "found: install one (e.g. gcc) or set CC, or use --backend numpy"
         )
@@ -223,7 +223,7 @@ def _build(
                 break
         else:
             first = (result.stderr.strip().splitlines() or ["(no message)"])[0]
-            raise Rpr3genError(f"compiling the generated C of {variant.folder} failed: {first}")
+            raise SetupError(f"compiling the generated C of {variant.folder} failed: {first}")
         os.replace(built, target)
 
 

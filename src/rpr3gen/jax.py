@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 
 from rpr3gen import variants
+from rpr3gen.errors import InputTypeError
 from rpr3gen.jax_graph import COMPILER_OPTIONS, jax_module, single
 from rpr3gen.model import Model
 from rpr3gen.validation import Instance, checked
@@ -50,7 +51,7 @@ def function(model: Model, name: str) -> Callable[..., Any]:
     Raises:
         InputError: no such function in the bridges (the message lists those there are).
         InputTypeError: ``model`` is not a :class:`rpr3gen.Model`, or ``name`` not a string.
-        Rpr3genError: JAX is not installed (``pip install 'rpr3gen[jax]'``).
+        SetupError: JAX is not installed (``pip install 'rpr3gen[jax]'``).
     """
     variant = variants.load(model.structure, model.generated)
     one = single(variant, name)
@@ -62,7 +63,7 @@ def function(model: Model, name: str) -> Callable[..., Any]:
     def g(params: Any, *inputs: Any) -> Any:
         if len(inputs) + 1 != count:
             names = ", ".join(["params", *(a.name for a in info.inputs)])
-            raise TypeError(f"{name} takes {count} arguments ({names}), got {len(inputs) + 1}")
+            raise InputTypeError(f"{name} takes {count} arguments ({names}), got {len(inputs) + 1}")
         arrays = [jnp.asarray(a, jnp.float64) for a in (params, *inputs)]
         outputs, _ = one(*arrays)
         found = tuple(outputs[k] for k in public)

@@ -13,8 +13,8 @@ after these checks, each failing in one line that names the file and how to rege
 - ``rpr3_numpy.py`` imports (no syntax error, no missing module) and defines what the manifest
   lists, for the same variant and parameters.
 
-The errors are plain :class:`~rpr3gen.errors.Rpr3genError`: the environment is at fault, not an
-argument's value.
+The errors are :class:`~rpr3gen.errors.GeneratedCodeError` (an :class:`OSError`): the environment
+is at fault, not an argument's value.
 """
 
 from __future__ import annotations
@@ -26,7 +26,7 @@ from pathlib import Path
 from types import ModuleType
 
 from rpr3gen import manifest
-from rpr3gen.errors import Rpr3genError
+from rpr3gen.errors import GeneratedCodeError
 from rpr3gen.manifest import Variant, regenerate_hint
 
 __all__ = ["check_folder", "graph_module", "numpy_module"]
@@ -34,8 +34,8 @@ __all__ = ["check_folder", "graph_module", "numpy_module"]
 _HASH_LINE = "Source hash: "
 
 
-def _fail(path: Path, what: str, variant: Variant) -> Rpr3genError:
-    return Rpr3genError(f"{path}: {what}; {regenerate_hint(variant.folder.parent)}")
+def _fail(path: Path, what: str, variant: Variant) -> GeneratedCodeError:
+    return GeneratedCodeError(f"{path}: {what}; {regenerate_hint(variant.folder.parent)}")
 
 
 def _stamp(path: Path) -> str | None:
@@ -69,7 +69,7 @@ def check_files(variant: Variant) -> None:
 def _imported(path: Path, name: str) -> ModuleType:
     spec = importlib.util.spec_from_file_location(name, path)
     if spec is None or spec.loader is None:
-        raise Rpr3genError(f"{path}: not a Python module")
+        raise GeneratedCodeError(f"{path}: not a Python module")
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module
@@ -80,7 +80,7 @@ def numpy_module(variant: Variant) -> ModuleType:
     the manifest.
 
     Raises:
-        Rpr3genError: it does not import (a syntax error: its line; a missing module), or it
+        GeneratedCodeError: it does not import (a syntax error: its line; a missing module), or it
             is another variant's, or it lacks a function the manifest lists.
     """
     path = variant.path("numpy")
@@ -95,7 +95,7 @@ def numpy_module(variant: Variant) -> ModuleType:
         raise _fail(path, f"line {exc.lineno}: {exc.msg} (syntax error)", variant) from None
     except ImportError as exc:
         raise _fail(path, f"cannot import it: {exc}", variant) from None
-    except Rpr3genError:
+    except GeneratedCodeError:
         raise
     except Exception as exc:
         raise _fail(path, f"fails on import: {type(exc).__name__}: {exc}", variant) from None
@@ -118,7 +118,7 @@ def graph_module(variant: Variant) -> ModuleType:
     :func:`numpy_module` is.
 
     Raises:
-        Rpr3genError: the folder has no graph module (generated before it), or it does not
+        GeneratedCodeError: the folder has no graph module (generated before it), or it does not
             import, or it is another variant's, or it lacks a function the manifest lists.
     """
     if "graph" not in variant.files:

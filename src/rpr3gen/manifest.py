@@ -17,7 +17,7 @@ from functools import cache
 from importlib import resources
 from pathlib import Path
 
-from rpr3gen.errors import Rpr3genError
+from rpr3gen.errors import GeneratedCodeError
 
 #: The manifest format this runtime reads.
 FORMAT = 1
@@ -96,7 +96,7 @@ class Variant:
             return self.functions[name]
         except KeyError:
             known = ", ".join(self.functions)
-            raise Rpr3genError(
+            raise GeneratedCodeError(
                 f"{self.folder}: no generated function {name!r} (it has: {known}); "
                 "run `rpr3gen generate`"
             ) from None
@@ -176,28 +176,28 @@ def _load(folder: Path, variant: str) -> Variant:
         data = json.loads(path.read_text(encoding="utf-8"))
     except FileNotFoundError:
         found = ", ".join(available(folder)) or "none"
-        raise Rpr3genError(
+        raise GeneratedCodeError(
             f"{path}: no generated variant {variant!r} here (variants found: {found}); {hint}"
         ) from None
     except UnicodeDecodeError as exc:
-        raise Rpr3genError(f"{path}: not UTF-8 text (byte {exc.start}); {hint}") from None
+        raise GeneratedCodeError(f"{path}: not UTF-8 text (byte {exc.start}); {hint}") from None
     except ValueError as exc:
-        raise Rpr3genError(f"{path}: not JSON ({exc}); {hint}") from None
+        raise GeneratedCodeError(f"{path}: not JSON ({exc}); {hint}") from None
     except OSError as exc:
-        raise Rpr3genError(f"{path}: cannot read it: {exc.strerror or exc}; {hint}") from None
+        raise GeneratedCodeError(f"{path}: cannot read it: {exc.strerror or exc}; {hint}") from None
     found_format = data.get("format") if isinstance(data, dict) else None
     if found_format != FORMAT:
-        raise Rpr3genError(
+        raise GeneratedCodeError(
             f"{path}: manifest format {found_format!r}, this runtime reads {FORMAT}; {hint}"
         )
     try:
         return _variant(folder, variant, data)
     except KeyError as exc:
-        raise Rpr3genError(
+        raise GeneratedCodeError(
             f"{path}: damaged: no key {exc.args[0]!r} where one is needed; {hint}"
         ) from None
     except (TypeError, ValueError, AttributeError, StopIteration) as exc:
-        raise Rpr3genError(
+        raise GeneratedCodeError(
             f"{path}: damaged: {type(exc).__name__}: {exc or 'a value of the wrong kind'}; {hint}"
         ) from None
 

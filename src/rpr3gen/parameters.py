@@ -30,7 +30,7 @@ from threadpoolctl import threadpool_limits
 from rpr3gen import spatial_inertia, variants
 from rpr3gen.backends import evaluate
 from rpr3gen.control import platform_radius
-from rpr3gen.errors import IdentificationError, InputError, Rpr3genError
+from rpr3gen.errors import GeneratedCodeError, IdentificationError, InputError
 from rpr3gen.model import LEGS, Model
 from rpr3gen.validation import PoseRows, checked, match_width
 
@@ -233,7 +233,7 @@ def _check_names(model: Model) -> tuple[str, ...]:
     names = variant.tables.get(f"{variant.prefix}_inertial_parameter_names")
     expected = inertial_parameter_names(model)
     if names != expected:
-        raise Rpr3genError(
+        raise GeneratedCodeError(
             f"{variant.folder}: the generated regressor's columns are not this runtime's "
             "inertial parameter names (regenerate with rpr3gen generate)"
         )

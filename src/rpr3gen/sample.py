@@ -21,7 +21,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from rpr3gen import failures, variants
-from rpr3gen.errors import InputError, Rpr3genError
+from rpr3gen.errors import InputError
 from rpr3gen.evaluators import evaluator
 from rpr3gen.model import Model
 from rpr3gen.validation import Instance, Optional, Reading, checked
@@ -97,7 +97,8 @@ class SampleEvaluator:
         return code
 
     def evaluate(self, *inputs: ArrayLike) -> np.ndarray:
-        """Copy a sample in, evaluate, and return the first output; raise on a non-zero code."""
+        """Copy a sample in, evaluate, and return the first output; a non-zero code (a singular
+        pose, a non-finite input) raises an :class:`~rpr3gen.errors.InputError` naming it."""
         if len(inputs) != len(self.inputs):
             names = ", ".join(self.inputs)
             raise InputError(f"inputs: {self.function.name} takes {len(self.inputs)} ({names}), "
@@ -107,7 +108,7 @@ class SampleEvaluator:
         status = self()
         if status:
             first = next(iter(self.inputs))
-            raise Rpr3genError(
+            raise InputError(
                 f"sample {first}={self.inputs[first].tolist()}: {self.codes.get(status, status)}"
             )
         return next(iter(self.outputs.values()))

@@ -14,7 +14,7 @@ import numpy as np
 
 from rpr3gen import variants
 from rpr3gen.backends import inverse_dynamics, output_names
-from rpr3gen.errors import InputError, Rpr3genError
+from rpr3gen.errors import InputError, TrajectoryError
 from rpr3gen.model import Model
 from rpr3gen.paths import check_output
 from rpr3gen.policy import DEFAULT_MIN_CONDITIONING, Invalid, invalid_samples
@@ -41,7 +41,7 @@ def screen(
         return None
     if not allow_invalid:
         k = invalid.first
-        raise Rpr3genError(
+        raise TrajectoryError(
             f"t = {traj.t[k]:.6g} s (sample {k + 1} of {len(traj.t)}): {invalid.reason}; "
             "pass --allow-invalid to write such rows as NaN"
         )

@@ -78,7 +78,7 @@ def memory_limit() -> int:
     """The memory (bytes) any one size may make rpr3gen allocate.
 
     Raises:
-        Rpr3genError: ``RPR3GEN_MAX_MEMORY`` is set to something that is not a size.
+        InputError: ``RPR3GEN_MAX_MEMORY`` is set to something that is not a size.
     """
     text = os.environ.get(MEMORY_VARIABLE, "").strip()
     if text:
@@ -98,13 +98,13 @@ _SIZE = re.compile(r"^(?P<number>\d+(\.\d+)?)\s*(?P<unit>[KMGT]?)(i?B)?$", re.IG
 def _parse_bytes(text: str) -> int:
     found = _SIZE.match(text)
     if found is None:
-        raise Rpr3genError(
+        raise InputError(
             f"{MEMORY_VARIABLE}={text!r}: not a memory size; give bytes or e.g. 512M, 8G, 1T"
         )
     power = "KMGT".find(found["unit"].upper()) + 1 if found["unit"] else 0
     value = int(float(found["number"]) * 1024**power)
     if value < 1:
-        raise Rpr3genError(f"{MEMORY_VARIABLE}={text!r}: must be at least one byte")
+        raise InputError(f"{MEMORY_VARIABLE}={text!r}: must be at least one byte")
     return value
 
 

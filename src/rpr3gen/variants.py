@@ -26,7 +26,7 @@ from functools import cache
 from pathlib import Path
 
 from rpr3gen import manifest
-from rpr3gen.errors import InputError, Rpr3genError
+from rpr3gen.errors import InputError, SetupError
 from rpr3gen.structure import Structure
 
 __all__ = ["cache_root", "ensure", "folder", "generator_hash", "load"]
@@ -46,7 +46,7 @@ def generator_hash() -> str:
     try:
         from rpr3gen_derive.planar.fingerprint import generator_hash as derive_hash
     except ImportError as exc:  # pragma: no cover - the wheel always carries rpr3gen_derive
-        raise Rpr3genError(f"the generator rpr3gen_derive is not installed ({exc})") from None
+        raise SetupError(f"the generator rpr3gen_derive is not installed ({exc})") from None
     return derive_hash()
 
 
@@ -79,7 +79,7 @@ def _derive(structure: Structure, root: Path) -> None:
         from rpr3gen_derive.codegen.files import write_files
         from rpr3gen_derive.planar import generate
     except ImportError as exc:
-        raise Rpr3genError(
+        raise SetupError(
             f"the {structure.title} is not generated yet and deriving it needs sympy and "
             f"jinja2 ({exc.name} is missing): pip install 'rpr3gen[derive]', or generate it "
             "elsewhere with `rpr3gen generate --leg ... --actuated ... --out DIR`"

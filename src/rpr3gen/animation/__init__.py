@@ -125,7 +125,7 @@ def write_animation(
 
     Raises:
         InputError: For a request out of bounds (see :func:`plan`).
-        Rpr3genError: For a trajectory through an invalid pose.
+        TrajectoryError: For a trajectory through an invalid pose.
         OSError: If the file cannot be written.
     """
     the_plan = plan(traj.t, out, fps=fps, speed=speed, size=size)

@@ -12,7 +12,7 @@ import numpy as np
 
 from rpr3gen import variants
 from rpr3gen.backends import evaluate, inverse_dynamics
-from rpr3gen.errors import Rpr3genError
+from rpr3gen.errors import TrajectoryError
 from rpr3gen.model import Model
 from rpr3gen.policy import DEFAULT_MIN_CONDITIONING, invalid_samples
 from rpr3gen.structure import LEGS
@@ -72,7 +72,7 @@ def scene(
             simulate`` does.
 
     Raises:
-        Rpr3genError: If a sample is singular, too close to a singularity or outside a joint
+        TrajectoryError: If a sample is singular, too close to a singularity or outside a joint
             limit (the message names the first one and why).
     """
     out = inverse_dynamics(model, traj.q, traj.qd, traj.qdd, backend=backend)
@@ -80,7 +80,7 @@ def scene(
     invalid = invalid_samples(model, traj.q, out, min_conditioning, thresholds)
     if invalid is not None:
         k = invalid.first
-        raise Rpr3genError(
+        raise TrajectoryError(
             f"t = {traj.t[k]:.6g} s (sample {k + 1} of {len(traj.t)}): {invalid.reason}; "
             "the animation draws valid poses only"
         )

@@ -7,7 +7,7 @@ import argparse
 from pathlib import Path
 
 from rpr3gen import variants
-from rpr3gen.errors import InputError, Rpr3genError, did_you_mean
+from rpr3gen.errors import GeneratedCodeError, InputError, SetupError, did_you_mean
 from rpr3gen.model import load_model
 from rpr3gen.paths import check_output
 from rpr3gen.structure import LEG_TYPES, SPATIAL_LEG_TYPES, Structure
@@ -68,14 +68,14 @@ def run(args: argparse.Namespace) -> int:
         from rpr3gen_derive.codegen import files as codegen_files
         from rpr3gen_derive.planar import generate
     except ImportError as exc:
-        raise Rpr3genError(
+        raise SetupError(
             f"regeneration needs sympy and jinja2 ({exc.name} is missing): "
             "pip install 'rpr3gen[derive]'"
         ) from exc
     one = _structure(args)
     if one is not None:
         if one.singular:
-            raise Rpr3genError(
+            raise InputError(
                 f"--actuated: a {one.title} cannot move: both its passive joints are prismatic "
                 "(architecturally singular); nothing to generate"
             )
@@ -92,14 +92,14 @@ def run(args: argparse.Namespace) -> int:
     else:
         out_dir = Path(args.out) if args.out else generate.default_out_dir()
         if out_dir is None:
-            raise Rpr3genError("no source tree's generated/ folder here; name one with --out DIR")
+            raise SetupError("no source tree's generated/ folder here; name one with --out DIR")
         if not args.check:
             check_output(out_dir, "the generated sources", folder=True, argument="out")
         files = generate.render(generate.COMMITTED)
     if args.check:
         stale = codegen_files.stale_files(out_dir, files)
         if stale:
-            raise Rpr3genError(
+            raise GeneratedCodeError(
                 f"{out_dir}: stale or edited generated files: {', '.join(stale)}; "
                 "run `rpr3gen generate`"
             )

@@ -26,7 +26,7 @@ from collections.abc import Callable, Iterable, Iterator
 from typing import Any
 
 from rpr3gen.design.metrics import SweepPlan
-from rpr3gen.errors import Rpr3genError
+from rpr3gen.errors import Rpr3genError, SetupError
 
 __all__ = ["MALLOC_TRIM", "ClusterClient", "run_chunks", "task_result"]
 
@@ -108,7 +108,7 @@ def task_result(future: Any) -> tuple[int, Columns]:
     except Rpr3genError:
         raise
     except Exception as exc:
-        raise Rpr3genError(
+        raise SetupError(
             f"a sweep task failed on the Dask cluster: {type(exc).__name__}: {exc}"
         ) from exc
     return result
@@ -131,7 +131,7 @@ class ClusterClient:
             try:
                 self.client = Client(self.address, timeout="30s")
             except (OSError, TimeoutError, ValueError) as exc:
-                raise Rpr3genError(f"scheduler {self.address}: cannot connect: {exc}") from None
+                raise SetupError(f"scheduler {self.address}: cannot connect: {exc}") from None
             return self.client
         n = self.workers or len(os.sched_getaffinity(0))
         try:

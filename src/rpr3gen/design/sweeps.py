@@ -43,6 +43,7 @@ from rpr3gen.design.sweep_checks import (
 from rpr3gen.errors import (
     InputError,
     Rpr3genError,
+    SetupError,
     TrajectoryError,
     did_you_mean,
 )
@@ -174,7 +175,7 @@ def sweep(
 
     Raises:
         ModelError, GridError, TrajectoryError, InputError: bad input, before any work.
-        Rpr3genError: an interrupted sweep's chunks are in the way (without ``resume``), or
+        SetupError: an interrupted sweep's chunks are in the way (without ``resume``), or
             they belong to another sweep.
     """
     if out is None and resume:
@@ -207,7 +208,8 @@ def sweep(
     try:
         run_chunks(plan, todo, evaluate_chunk, keep, scheduler, workers, progress, initial=initial)
     except Rpr3genError as exc:
-        raise Rpr3genError(f"{exc}; the chunks done are in {folder}: rerun with --resume") from exc
+        hint = f"{exc}; the chunks done are in {folder}: rerun with --resume"
+        raise type(exc)(hint, argument=exc.argument) from exc  # the same class, with the hint
     except KeyboardInterrupt as exc:
         raise SweepInterrupted(len(_done_chunks(plan, folder)), plan.chunks, folder) from exc
     target.parent.mkdir(parents=True, exist_ok=True)
@@ -403,7 +405,7 @@ def _open_parts(plan: SweepPlan, folder: Path, resume: bool) -> Path:
     stamp = {"identity": identity(plan), "designs": len(plan.grid), "chunks": plan.chunks}
     if folder.exists():
         if not resume:
-            raise Rpr3genError(
+            raise SetupError(
                 f"{folder}: holds the chunks of an interrupted sweep; pass --resume "
                 "(resume=True) to continue it, or remove the folder"
             )
@@ -412,7 +414,7 @@ def _open_parts(plan: SweepPlan, folder: Path, resume: bool) -> Path:
         except (OSError, ValueError):
             found = None
         if found != stamp:
-            raise Rpr3genError(
+            raise SetupError(
                 f"{folder}: holds the chunks of another sweep (other model, grid, "
                 "trajectories, options or version); remove it to start this one"
             )

@@ -5,7 +5,7 @@ A model read from a file is checked key by key first (:mod:`rpr3gen.model.paper`
 :mod:`rpr3gen.model.general`); these checks make a model built in code just as safe: a wrong
 type is an :class:`~rpr3gen.errors.InputTypeError`, a bad value a
 :class:`~rpr3gen.errors.ModelError` naming the field, and a generated folder that is damaged or
-of another version a plain :class:`~rpr3gen.errors.Rpr3genError` (:mod:`rpr3gen.loader`).
+of another version a :class:`~rpr3gen.errors.GeneratedCodeError` (:mod:`rpr3gen.loader`).
 """
 
 from __future__ import annotations

@@ -80,8 +80,8 @@ def _per_actuator(name: str, limit: np.ndarray, model: Model) -> np.ndarray:
 
 
 def _toppra() -> ModuleType:
-    """:mod:`rpr3gen.retiming.topp`, which imports toppra (a plain :class:`Rpr3genError` naming
-    the extra when it is not installed: the environment's, as a missing C compiler)."""
+    """:mod:`rpr3gen.retiming.topp`, which imports toppra (a :class:`~rpr3gen.errors.SetupError`
+    naming the extra when it is not installed: the environment's, as a missing C compiler)."""
     return importlib.import_module("rpr3gen.retiming.topp")
 
 
@@ -174,7 +174,7 @@ def retime(
         TrajectoryError: the same of a path file, naming its line, or a file that cannot be
             read.
         InputTypeError: an argument of the wrong type.
-        Rpr3genError: toppra is not installed (the message names the extra to install).
+        SetupError: toppra is not installed (the message names the extra to install).
     """
     # The arguments as @checked converted them: arrays of limits, a file name or an array.
     effort = _per_actuator("effort_limit", np.asarray(effort_limit), model)

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from rpr3gen.errors import Rpr3genError
+from rpr3gen.errors import SetupError
 
 EXTRA = "pip install 'rpr3gen[toppra]'"
 """How to install TOPP-RA, for the message of its absence."""
@@ -29,7 +29,7 @@ try:
 except ImportError as exc:  # the extra is not installed: one line that names it
     if (exc.name or "").split(".")[0] != "toppra":
         raise
-    raise Rpr3genError(
+    raise SetupError(
         "retime needs TOPP-RA (the package toppra), which is not installed: install the extra "
         f"'toppra': {EXTRA}"
     ) from None
