@@ -245,6 +245,28 @@ def test_chunks_in_the_way_need_resume(tmp_path: Path, capsys: pytest.CaptureFix
     assert (parts / "chunk-000000.parquet").read_bytes() == b"earlier work"
 
 
+def test_a_failure_keeps_its_class_and_says_where_the_chunks_are(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A scheduler lost mid-sweep (an OSError of the environment) stays a SetupError, with how
+    to resume added; a bad value stays an InputError naming its argument."""
+    out = tmp_path / "s.parquet"
+    for error in (
+        rpr3gen.SetupError("scheduler tcp://x:8786: cannot connect: refused"),
+        rpr3gen.InputError("samples: too many", argument="samples"),
+    ):
+
+        def fail(*args: Any, error: Exception = error, **kwargs: Any) -> None:
+            raise error
+
+        monkeypatch.setattr(sweeps, "run_chunks", fail)
+        with pytest.raises(type(error)) as info:
+            rpr3gen.sweep(None, GRID, out=out, workers=0, resume=True, **OPTIONS)
+        assert str(info.value).startswith(f"{error}; the chunks done are in ")
+        assert str(info.value).endswith(": rerun with --resume")
+        assert info.value.argument == error.argument
+
+
 def test_resuming_another_grid_is_refused(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     out = tmp_path / "s.parquet"
 
