@@ -190,3 +190,47 @@ def test_a_pose_out_of_reach_is_a_nan_row(backend: str) -> None:
     for block in (d.tau, d.dq, d.dqd, d.dqdd, f.qdd, f.dq, f.dqd, f.dtau):
         assert np.isfinite(block[0]).all()
         assert np.isnan(block[1]).all()
+
+
+def test_the_cache_derives_the_derivatives_apart_on_their_first_call(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capfd: pytest.CaptureFixture[str]
+) -> None:
+    """A first use derives the variant without its derivatives (its manifest defers them); the
+    first derivative call derives the whole variant into a folder of its own, whose main C files
+    are the first folder's byte for byte (one main library for both), and whose derivatives
+    are right. A generated folder that defers them refuses a derivative call in one line."""
+    from rpr3gen import cbackend, manifest, variants
+
+    monkeypatch.setenv("RPR3GEN_CACHE_DIR", str(tmp_path))
+    rng = np.random.default_rng(29)
+    data = pm.random_model(rng, "PRR", 1)
+    model = rpr3gen.model_from_dict(data, source="random-PRR-1")
+    robot = pr.parse_model(data)
+    q, qd, qdd = pm.random_motion(rng, robot, np.linspace(0.0, 2.0, SAMPLES))
+    tau = pr.efforts(pr.solve(robot, q, qd, qdd))
+
+    rpr3gen.inverse_dynamics(model, q, qd, qdd, backend="c")
+    first = variants.folder(model.structure)
+    whole = variants.folder(model.structure, whole=True)
+    base = manifest.load(model.variant, first)
+    assert base.deferred == ("inverse_dynamics_derivatives", "forward_dynamics_derivatives")
+    assert not set(base.deferred) & set(base.functions)
+    assert not whole.exists()
+    assert "deriving the derivatives" not in capfd.readouterr().err
+
+    for backend in ("c", "numpy"):
+        d = rpr3gen.inverse_dynamics_derivatives(model, q, qd, qdd, backend=backend)
+        _close(d.tau, tau, f"tau, {backend}")
+    assert "deriving the derivatives" in capfd.readouterr().err
+    full = manifest.load(model.variant, whole)
+    assert full.deferred == ()
+    assert set(base.deferred) < set(full.functions)
+    for name in ("rpr3.c", "rpr3.h"):
+        assert (first / model.variant / name).read_bytes() == full.path(
+            "c_source" if name.endswith(".c") else "c_header"
+        ).read_bytes(), name
+    assert cbackend.library_path(base) == cbackend.library_path(full)
+
+    with pytest.raises(rpr3gen.Rpr3genError, match="rpr3gen generate --out") as info:
+        variants.load(model.structure, first, "inverse_dynamics_derivatives")
+    assert "\n" not in str(info.value)

@@ -136,7 +136,7 @@ def test_a_variant_of_another_generator_is_not_reused(
     (stale / "__init__.py").touch()
     calls: list[Path] = []
 
-    def derive(s: Structure, root: Path) -> None:
+    def derive(s: Structure, root: Path, whole: bool = False) -> None:
         calls.append(root)
         shutil.copytree(committed, root / s.variant)
 

@@ -11,8 +11,9 @@ function), then the inverse dynamics derivatives' kernel at that ``q''``, and so
 [-d tau/d q, -d tau/d q', I]`` by Gaussian elimination with partial pivoting; the runtime
 composes the same in NumPy.
 
-Both are in the C translation unit ``derivatives`` (:data:`UNIT`), compiled apart and only when
-first called: they are several times the inverse dynamics' size.
+Both are in the C translation unit ``derivatives`` (:data:`UNIT`), with a header of their own,
+compiled apart and only when first called: they are several times the inverse dynamics' size.
+The runtime's cache derives them apart too, when one is first called (:data:`NAMES`).
 """
 
 from __future__ import annotations
@@ -22,6 +23,9 @@ from rpr3gen_derive.codegen.adjoint import reverse_mode
 from rpr3gen_derive.codegen.program import Program
 from rpr3gen_derive.codegen.spec import Argument, Check, Component, FunctionSpec, Output
 
+#: The derivative functions, in the registries' order: a variant's derivation leaves them out
+#: when the runtime's cache asks it to (:attr:`ModuleSpec.deferred`), for a first use of one.
+NAMES = ("inverse_dynamics_derivatives", "forward_dynamics_derivatives")
 #: The C translation unit of the derivatives (:attr:`FunctionSpec.unit`): compiled apart, on
 #: first use.
 UNIT = "derivatives"

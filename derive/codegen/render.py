@@ -68,6 +68,7 @@ def manifest(module: ModuleSpec, digest: str, files: dict[str, str]) -> str:
         ],
         "tables": {f"{prefix}_{t.table}": _components(t) for t in module.tables},
         "defines": {name: literal for name, literal, _ in module.defines},
+        "deferred": list(module.deferred),
         "functions": [
             {
                 "name": f.name,

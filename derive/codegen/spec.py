@@ -209,6 +209,10 @@ class ModuleSpec:
     engine names each leg's temporaries after the first leg's (:mod:`.legnames`) and runs the
     legs' alike statements side by side (the C lanes, the NumPy backend's leg blocks). Empty
     (the default) or one leg: nothing is shared between legs.
+
+    ``deferred`` names functions of the variant that this module leaves out, for the runtime to
+    derive when one is first called (its cache does so with the derivatives, which take most of
+    a variant's derivation): the manifest lists them, so that the runtime knows to.
     """
 
     prefix: str
@@ -221,6 +225,7 @@ class ModuleSpec:
     defines: tuple[tuple[str, str, str], ...] = field(default_factory=tuple)
     tables: tuple[Argument, ...] = field(default_factory=tuple)
     legs: str = ""
+    deferred: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         if len(set(self.legs)) != len(self.legs) or not all(
@@ -236,6 +241,8 @@ class ModuleSpec:
         names = [f.name for f in self.functions]
         if len(set(names)) != len(names):
             raise ValueError(f"functions defined twice in {names}")
+        if set(self.deferred) & set(names):
+            raise ValueError(f"deferred functions defined here: {set(self.deferred) & set(names)}")
         for function in self.functions:
             later = {c.code for c in function.checks if c.kind != "inputs_not_finite"}
             if len(later) > 1:

@@ -9,12 +9,15 @@ cache on first use).
 
 from __future__ import annotations
 
+import dataclasses
 import multiprocessing
 import os
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Mapping, Sequence
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
+from typing import Any
 
+from rpr3gen_derive.codegen import derivatives
 from rpr3gen_derive.codegen.render import Generator, Stage, no_stage
 from rpr3gen_derive.codegen.spec import ModuleSpec
 from rpr3gen_derive.planar import registry
@@ -37,6 +40,11 @@ COMMITTED: tuple[Structure | SpatialStructure, ...] = (
 )
 
 
+#: The functions that the runtime's cache derives apart, when one is first called: the
+#: derivatives of the dynamics, three quarters of a variant's derivation (docs/derivatives.md).
+ON_DEMAND: tuple[str, ...] = derivatives.NAMES
+
+
 def structure_of(leg: str, actuated: int, paper: bool = False) -> Structure | SpatialStructure:
     """The derivation's structure of a leg type and actuated joint, planar or spatial."""
     if leg in SPATIAL_LEG_TYPES:
@@ -45,12 +53,21 @@ def structure_of(leg: str, actuated: int, paper: bool = False) -> Structure | Sp
 
 
 def module(
-    structure: Structure | SpatialStructure, functions: Mapping[str, FunctionBuilder] | None = None
+    structure: Structure | SpatialStructure,
+    functions: Mapping[str, FunctionBuilder] | None = None,
+    defer: Sequence[str] = (),
 ) -> ModuleSpec:
-    """The generated module of a planar or spatial structure."""
+    """The generated module of a planar or spatial structure, without the functions ``defer``
+    names (listed as deferred: the runtime's cache derives them on first use)."""
     if isinstance(structure, SpatialStructure):
-        return spatial_registry.module(structure, functions)  # type: ignore[arg-type]
-    return registry.module(structure, functions)
+        every: Mapping[str, Any] = spatial_registry.FUNCTIONS if functions is None else functions
+        kept = {name: f for name, f in every.items() if name not in defer}
+        found = spatial_registry.module(structure, kept)
+    else:
+        every = registry.FUNCTIONS if functions is None else functions
+        found = registry.module(structure, {n: f for n, f in every.items() if n not in defer})
+    deferred = tuple(name for name in every if name in defer)
+    return dataclasses.replace(found, deferred=deferred) if deferred else found
 
 
 PACKAGE_DOC = """Generated code of rpr3gen, one folder per variant (a leg type, its actuated joint).
@@ -76,10 +93,13 @@ def render(
     functions: Mapping[str, FunctionBuilder] | None = None,
     stage: Stage = no_stage,
     package: Iterable[Structure | SpatialStructure] | None = None,
+    defer: Sequence[str] = (),
 ) -> dict[str, str]:
     """Every generated file for ``structures``, ``{relative path: text}``.
 
     ``package``: the variants the folder's ``__init__.py`` lists (default: ``structures``).
+    ``defer``: functions left out, listed as deferred (the runtime's cache derives a variant
+    without :data:`ON_DEMAND`, then those when one is first called).
     Several structures are rendered side by side, one process each (forked, so they share the
     parent's hash seed and imports), on as many cores as there are; each variant's files depend
     on its structure alone, so the result is the same as one after the other.
@@ -87,7 +107,7 @@ def render(
     structures = tuple(structures)
     listed = structures if package is None else tuple(package)
     workers = min(len(structures), os.cpu_count() or 1)
-    if workers > 1 and functions is None and stage is no_stage and _can_fork():
+    if workers > 1 and functions is None and not defer and stage is no_stage and _can_fork():
         files: dict[str, str] = {}
         context = multiprocessing.get_context("fork")
         # the costliest first (revolute joints give the longest expressions), so that the
@@ -97,7 +117,7 @@ def render(
             for part in pool.map(_render_one, order, [listed] * len(order)):
                 files.update(part)
         return dict(sorted(files.items()))
-    return _render(structures, functions, stage, listed)
+    return _render(structures, functions, stage, listed, defer)
 
 
 def _render(
@@ -105,13 +125,14 @@ def _render(
     functions: Mapping[str, FunctionBuilder] | None,
     stage: Stage,
     listed: tuple[Structure | SpatialStructure, ...],
+    defer: Sequence[str] = (),
 ) -> dict[str, str]:
     """:func:`render` in this process, one structure after the other."""
     gen = generator(stage)
     modules = []
     for structure in structures:
         with stage(f"variant:{structure.variant}"), stage("derive"):
-            modules.append(module(structure, functions))
+            modules.append(module(structure, functions, defer))
     return gen.render(modules, variants=tuple(s.variant for s in listed))
 
 

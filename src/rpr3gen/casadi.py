@@ -140,7 +140,7 @@ def function(model: Model, name: str) -> Any:
         InputTypeError: ``model`` is not a :class:`rpr3gen.Model`, or ``name`` not a string.
         SetupError: CasADi is not installed (``pip install 'rpr3gen[casadi]'``).
     """
-    return _function(variants.load(model.structure, model.generated), name)
+    return _function(variants.load(model.structure, model.generated, name), name)
 
 
 @checked()

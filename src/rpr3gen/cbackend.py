@@ -113,11 +113,14 @@ def _compiler() -> list[str]:
     return command
 
 
-def sources(variant: Variant, unit: str = "") -> tuple[bytes, bytes]:
+def sources(variant: Variant, unit: str = "") -> tuple[bytes, dict[str, bytes]]:
     """The generated C source of a translation unit (``""``: the variant's main one) and the
-    header, checked (:mod:`rpr3gen.loader`)."""
+    headers it includes, by file name (a unit's own and the main one), checked
+    (:mod:`rpr3gen.loader`)."""
     check_files(variant)
-    return variant.path(_source_role(unit)).read_bytes(), variant.path("c_header").read_bytes()
+    roles = ["c_header", *([f"c_header_{unit}"] if unit else [])]
+    headers = {variant.files[role]: variant.path(role).read_bytes() for role in roles}
+    return variant.path(_source_role(unit)).read_bytes(), headers
 
 
 def _source_role(unit: str) -> str:
@@ -126,7 +129,8 @@ def _source_role(unit: str) -> str:
 
 def shim(variant: Variant, unit: str = "") -> bytes:
     """C source of the one-pointer entry points, one per function of the unit."""
-    lines = [f'#include "{variant.files["c_header"]}"', ""]
+    header = variant.files[f"c_header_{unit}" if unit else "c_header"]
+    lines = [f'#include "{header}"', ""]
     for f in variant.functions.values():
         if f.unit != unit:
             continue
@@ -163,7 +167,7 @@ def library_path(variant: Variant, unit: str = "") -> Path:
     """Path of the compiled library of ``variant``'s translation unit ``unit`` (``""``: the
     main one), building it if it is not in the cache. A unit's library is linked to the main
     library (whose public functions it may call), which is built first."""
-    source, header = sources(variant, unit)
+    source, headers = sources(variant, unit)
     glue = shim(variant, unit)
     command = _compiler()
     link: tuple[str, ...] = ()
@@ -175,7 +179,7 @@ def library_path(variant: Variant, unit: str = "") -> Path:
         cflags = tuple("-O0" if f == "-O3" else f for f in CFLAGS)
     digest = hashlib.sha256()
     flags = " ".join(command + list(cflags) + list(LIBS) + list(link)).encode()
-    for part in (source, header, glue, flags):
+    for part in (source, *(headers[name] for name in sorted(headers)), glue, flags):
         digest.update(part)
         digest.update(b"\0")
     folder = cache_dir()
@@ -186,11 +190,7 @@ def library_path(variant: Variant, unit: str = "") -> Path:
     folder.mkdir(parents=True, exist_ok=True)
     with _exclusive(folder / f".{target.name}.lock"):
         if not target.is_file():  # else built by another process while this one waited
-            files = {
-                variant.files[_source_role(unit)]: source,
-                variant.files["c_header"]: header,
-                "shim.c": glue,
-            }
+            files = {variant.files[_source_role(unit)]: source, **headers, "shim.c": glue}
             source_name = variant.files[_source_role(unit)]
             _build(variant, command, files, target, source_name, link, cflags)
     return target

@@ -53,7 +53,7 @@ def function(model: Model, name: str) -> Callable[..., Any]:
         InputTypeError: ``model`` is not a :class:`rpr3gen.Model`, or ``name`` not a string.
         SetupError: JAX is not installed (``pip install 'rpr3gen[jax]'``).
     """
-    variant = variants.load(model.structure, model.generated)
+    variant = variants.load(model.structure, model.generated, name)
     one = single(variant, name)
     info = variant.function(name)
     public = [k for k, o in enumerate(info.outputs) if not o.hidden]

@@ -89,6 +89,9 @@ class Variant:
     tables: dict[str, tuple[str, ...]] = field(default_factory=dict)  # extra name tables
     #: The C header's extra macros by name, as C literals (``LEG``: ``"\"UPS\""``, ``DOF``).
     defines: dict[str, str] = field(default_factory=dict)
+    #: Functions of the variant that this folder leaves out: the runtime's cache derives a
+    #: variant without its derivatives, and them when one is first called (:mod:`.variants`).
+    deferred: tuple[str, ...] = ()
 
     def function(self, name: str) -> FunctionInfo:
         """The function called ``name`` (without the prefix), or a clear error."""
@@ -221,6 +224,7 @@ def _variant(folder: Path, variant: str, data: dict) -> Variant:
             name: tuple(c["name"] for c in comps) for name, comps in data.get("tables", {}).items()
         },
         defines={str(k): str(v) for k, v in dict(data.get("defines", {})).items()},
+        deferred=tuple(str(name) for name in data.get("deferred", ())),
     )
     missing = [role for role in ("numpy", "c_header", "c_source") if role not in found.files]
     if missing:

@@ -8,7 +8,14 @@ The package ``rpr3gen_generated`` carries the committed variants (the paper's ``
 ``key`` is a content hash of the generator's sources (``rpr3gen_derive``, what every generated
 file's header carries) and the variant: editing the derivation makes new keys, never stale code.
 Deriving needs SymPy and Jinja2 (the ``derive`` extra) and takes a few seconds; a message on
-stderr says so. Two processes that need the same variant at once do not both derive it: a file
+stderr says so.
+
+A first use derives the variant without the derivatives of its dynamics, which take three
+quarters of a variant's derivation (a hexapod's: 18 of 23 s of CPU) and are seldom called: its
+manifest lists them as ``deferred``. The first call of one derives the whole variant into a
+folder of its own, ``<variant>-<key>-whole`` (its main C unit is byte-identical to the first
+folder's, so its library is not built again). The committed variants and ``rpr3gen generate``
+are whole. Two processes that need the same variant at once do not both derive it: a file
 lock serialises them, and the variant appears by an atomic rename of a complete folder, so no
 process ever reads a half-written one.
 """
@@ -50,10 +57,12 @@ def generator_hash() -> str:
     return derive_hash()
 
 
-def folder(structure: Structure) -> Path:
-    """The cache folder (a generated package's root) of a structure's variant."""
+def folder(structure: Structure, whole: bool = False) -> Path:
+    """The cache folder (a generated package's root) of a structure's variant: the one a first
+    use derives (without the deferred functions), or with ``whole`` the one with every
+    function."""
     key = hashlib.sha256(f"{generator_hash()}\0{structure.variant}".encode()).hexdigest()[:16]
-    return cache_root() / f"{structure.variant}-{key}"
+    return cache_root() / (f"{structure.variant}-{key}" + ("-whole" if whole else ""))
 
 
 @contextlib.contextmanager
@@ -73,8 +82,9 @@ def _locked(path: Path) -> Iterator[None]:
             fcntl.flock(handle, fcntl.LOCK_UN)
 
 
-def _derive(structure: Structure, root: Path) -> None:
-    """Derive and write the variant's files into ``root/<variant>`` (atomically)."""
+def _derive(structure: Structure, root: Path, whole: bool = False) -> None:
+    """Derive and write the variant's files into ``root/<variant>`` (atomically): without the
+    functions the generator derives on demand unless ``whole``."""
     try:
         from rpr3gen_derive.codegen.files import write_files
         from rpr3gen_derive.planar import generate
@@ -84,13 +94,15 @@ def _derive(structure: Structure, root: Path) -> None:
             f"jinja2 ({exc.name} is missing): pip install 'rpr3gen[derive]', or generate it "
             "elsewhere with `rpr3gen generate --leg ... --actuated ... --out DIR`"
         ) from exc
-    print(
-        f"rpr3gen: deriving the {structure.title} (first use, a few seconds); cached in {root}",
-        file=sys.stderr,
-        flush=True,
+    what = (
+        f"the derivatives of the {structure.title} (their first use, up to a minute)"
+        if whole
+        else f"the {structure.title} (first use, a few seconds)"
     )
+    print(f"rpr3gen: deriving {what}; cached in {root}", file=sys.stderr, flush=True)
     target = generate.structure_of(structure.leg, structure.actuated, structure.paper)
-    files = generate.render((target,), package=(target,))
+    defer = () if whole else generate.ON_DEMAND
+    files = generate.render((target,), package=(target,), defer=defer)
     root.mkdir(parents=True, exist_ok=True)
     staging = Path(tempfile.mkdtemp(prefix=".staging-", dir=root))
     try:
@@ -108,14 +120,17 @@ def _derive(structure: Structure, root: Path) -> None:
         shutil.rmtree(staging, ignore_errors=True)
 
 
-def ensure(structure: Structure) -> Path:
-    """The cache folder holding the structure's variant, deriving it first when missing."""
-    root = folder(structure)
+def ensure(structure: Structure, whole: bool = False) -> Path:
+    """The cache folder holding the structure's variant (``whole``: with every function),
+    deriving it first when missing."""
+    root = folder(structure, whole)
     if (root / structure.variant / "manifest.json").is_file():
         return root
+    if not whole and (folder(structure, True) / structure.variant / "manifest.json").is_file():
+        return folder(structure, True)
     with _locked(root.with_name(root.name + ".lock")):
         if not (root / structure.variant / "manifest.json").is_file():
-            _derive(structure, root)
+            _derive(structure, root, whole)
     return root
 
 
@@ -133,14 +148,32 @@ def _installed(variant: str) -> bool:
     return True
 
 
-def load(structure: Structure, generated: str | os.PathLike[str] | None = None) -> manifest.Variant:
+def load(
+    structure: Structure,
+    generated: str | os.PathLike[str] | None = None,
+    function: str | None = None,
+) -> manifest.Variant:
     """The manifest of a structure's variant: from ``generated`` when given, else the installed
-    package, else the cache (derived on first use)."""
+    package, else the cache (derived on first use). ``function``: a function the caller will
+    call; if the cache's variant defers it, the whole variant (derived on its first use).
+
+    Raises:
+        Rpr3genError: ``generated`` is a folder that defers ``function`` (a cache folder).
+    """
     if generated is not None:
-        return manifest.load(structure.variant, generated)
-    if _installed(structure.variant):
-        return manifest.load(structure.variant)
-    return manifest.load(structure.variant, ensure(structure))
+        found = manifest.load(structure.variant, generated)
+    elif _installed(structure.variant):
+        found = manifest.load(structure.variant)
+    else:
+        found = manifest.load(structure.variant, ensure(structure))
+    if function is None or function not in found.deferred:
+        return found
+    if generated is not None:
+        raise Rpr3genError(
+            f"{found.folder}: {function} is not in this folder (a cache's, derived without the "
+            f"derivatives): generate the whole variant, rpr3gen generate --out {generated}"
+        )
+    return manifest.load(structure.variant, ensure(structure, whole=True))
 
 
 def load_function(
@@ -151,7 +184,7 @@ def load_function(
     Raises:
         InputError: no such function, naming the argument and the variant's functions.
     """
-    variant = load(structure, generated)
+    variant = load(structure, generated, function)
     if function not in variant.functions:
         known = ", ".join(variant.functions)
         raise InputError(

@@ -222,32 +222,41 @@ def render(
     stage: Stage,
 ) -> dict[str, tuple[str, str]]:
     """``{"c_header": (name, text), "c_source": (name, text), ...}`` of one module, with the
-    package files of :func:`.package.render` (``c_cmake``, ``c_pkgconfig``)."""
+    package files of :func:`.package.render` (``c_cmake``, ``c_pkgconfig``). A translation unit
+    of its own (:attr:`FunctionSpec.unit`) gets ``c_header_{unit}`` and ``c_source_{unit}``: the
+    main header declares only the main unit's functions, so that a variant whose unit is
+    deferred (:attr:`ModuleSpec.deferred`) has the same main files as the whole one."""
 
     with stage("print"):
         values = {name for c in compiled for name in c.spec.c_values}
         functions = {c.spec.name: _function(module, c, c.spec.name in values) for c in compiled}
     units = sorted({c.spec.unit for c in compiled if c.spec.unit})
-    every = _context(module, compiled, functions, digest)
+    main = [c for c in compiled if not c.spec.unit]
+    tables = name_tables(module, main)
     files: dict[str, tuple[str, str]] = {}
     with stage("render"):
-        header = env.get_template("backends/c/templates/header.h.jinja").render(every)
-        files["c_header"] = (f"{module.prefix}.h", header)
+        header = env.get_template("backends/c/templates/header.h.jinja")
+        files["c_header"] = (
+            f"{module.prefix}.h",
+            header.render(_context(module, main, functions, digest, tables)),
+        )
         source = env.get_template("backends/c/templates/source.c.jinja")
-        main = [c for c in compiled if not c.spec.unit]
         files["c_source"] = (
             f"{module.prefix}.c",
-            source.render(_context(module, main, functions, digest, name_tables(module, main))),
+            source.render(_context(module, main, functions, digest, tables)),
         )
+        unit_header = env.get_template("backends/c/templates/unit_header.h.jinja")
         for unit in units:
             members = [c for c in compiled if c.spec.unit == unit]
-            files[f"c_source_{unit}"] = (
-                f"{module.prefix}_{unit}.c",
-                source.render(_context(module, members, functions, digest, [], unit)),
-            )
+            context = _context(module, members, functions, digest, [], unit)
+            files[f"c_header_{unit}"] = (f"{module.prefix}_{unit}.h", unit_header.render(context))
+            files[f"c_source_{unit}"] = (f"{module.prefix}_{unit}.c", source.render(context))
         names = {"header": files["c_header"][0], "source": files["c_source"][0]}
         extra = [files[f"c_source_{unit}"][0] for unit in units]
-        files.update(package.render(module, digest, env, **names, extra_sources=extra))
+        headers = [files[f"c_header_{unit}"][0] for unit in units]
+        files.update(
+            package.render(module, digest, env, **names, extra_sources=extra, extra_headers=headers)
+        )
     return files
 
 

@@ -33,9 +33,11 @@ def render(
     header: str,
     source: str,
     extra_sources: Sequence[str] = (),
+    extra_headers: Sequence[str] = (),
 ) -> dict[str, tuple[str, str]]:
     """``{"c_cmake": ("CMakeLists.txt", text), "c_pkgconfig": ("<package>.pc.in", text)}``;
-    the library is built from ``source`` and ``extra_sources`` (the other translation units)."""
+    the library is built from ``source`` and ``extra_sources`` (the other translation units),
+    and installs ``header`` and ``extra_headers`` (theirs)."""
     package = package_name(module)
     context = {
         "module": module,
@@ -47,6 +49,9 @@ def render(
         "header": header,
         "source": source,
         "sources": " ".join([source, *extra_sources]),
+        "headers": " ".join([header, *extra_headers]),
+        "extra_headers": list(extra_headers),
+        "public_headers": ";".join([header, *extra_headers]),
     }
     return {
         "c_cmake": (
