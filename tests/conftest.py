@@ -8,6 +8,11 @@ share one cache of derived variants and C builds, a fresh folder per session unl
 each variant compiled once per session, by whichever worker needs it first, while the others
 wait on the cache's lock. A fresh folder makes the suite's time the same on every run, and
 leaves the user's own cache alone.
+
+The C libraries are quick builds (``RPR3GEN_C_BUILD=quick``, -O1: the same values bit for bit
+as the optimised ones, ``tests/test_c_build_modes.py``), with no optimised build left running in
+the background, unless ``RPR3GEN_C_BUILD`` is set; the tests of what the optimised flags do
+ask for them (:func:`optimised_c_builds`).
 """
 
 from __future__ import annotations
@@ -33,6 +38,7 @@ def pytest_configure(config: pytest.Config) -> None:
         folder = tempfile.mkdtemp(prefix="rpr3gen-test-cache-")
         os.environ["RPR3GEN_CACHE_DIR"] = folder
         config.stash[_CACHE_KEY] = folder
+    os.environ.setdefault("RPR3GEN_C_BUILD", "quick")
 
 
 def pytest_unconfigure(config: pytest.Config) -> None:
@@ -64,6 +70,18 @@ def quick_c_builds(monkeypatch: pytest.MonkeyPatch) -> None:
     flags = tuple("-O0" if f == "-O3" else f for f in cbackend.CFLAGS)
     assert flags != cbackend.CFLAGS
     monkeypatch.setattr(cbackend, "CFLAGS", flags)
+
+
+@pytest.fixture
+def optimised_c_builds(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The c backend builds with the runtime's optimised flags in this test, and waits for them
+    (``RPR3GEN_C_BUILD=optimised``): for the tests of what those flags do (gcc's vectorisers).
+    The libraries and evaluators this process loaded before (quick builds) are set aside."""
+    from rpr3gen import cbackend, evaluators
+
+    monkeypatch.setenv("RPR3GEN_C_BUILD", "optimised")
+    monkeypatch.setattr(cbackend, "_LIBRARIES", {})
+    monkeypatch.setattr(evaluators, "_EVALUATORS", {})
 
 
 # -- a Dask cluster ------------------------------------------------------------------------------

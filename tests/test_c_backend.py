@@ -71,6 +71,7 @@ def _batch(params, q, qd, qdd, actuation: str) -> tuple[np.ndarray, int]:
     return rows, int(failed)
 
 
+@pytest.mark.usefixtures("optimised_c_builds")
 @pytest.mark.parametrize("actuation", ACTUATIONS)
 def test_single_and_batch_agree_bit_for_bit(actuation: str) -> None:
     _, model, q, qd, qdd = next(c for c in _cases() if c[1].actuation == actuation)
@@ -105,6 +106,7 @@ def _generic_inputs(model: Model, function: manifest.FunctionInfo) -> list[np.nd
     return [np.ascontiguousarray(motion[a.name]) for a in function.inputs]
 
 
+@pytest.mark.usefixtures("optimised_c_builds")
 @pytest.mark.parametrize("actuation", ACTUATIONS)
 def test_every_function_single_and_batch_agree_bit_for_bit(actuation: str) -> None:
     """The runtime's library (its flags: gcc's basic-block vectoriser once fused multiply-adds in
@@ -370,6 +372,7 @@ def test_every_thread_count_gives_the_same_bits(function: str) -> None:
         assert all(a.tobytes() == b.tobytes() for a, b in zip(one, out, strict=True)), threads
 
 
+@pytest.mark.usefixtures("optimised_c_builds")
 def test_batch_recomputes_huge_angles_like_the_single_call() -> None:
     model = rpr3gen.load_model()
     lib, names = _library("revolute")

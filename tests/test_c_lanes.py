@@ -228,6 +228,7 @@ def test_the_hexapods_kernels_run_six_legs_as_lanes(repo_root: Path) -> None:
 
 
 @pytest.mark.slow
+@pytest.mark.usefixtures("optimised_c_builds")
 def test_the_hexapods_single_calls_give_the_batchs_bits(repo_root: Path) -> None:
     """The 6-UPS built with the runtime's flags (its legs as 8 lanes, which gcc vectorises):
     every function's single call, sample by sample, gives the bits of its batch (which runs the

@@ -451,6 +451,7 @@ def test_not_finite_input_returns_1(actuation: str) -> None:
     assert list(evaluator.q) == [7.0, 7.0, 7.0]
 
 
+@pytest.mark.usefixtures("optimised_c_builds")
 @pytest.mark.parametrize("actuation", ACTUATIONS)
 def test_single_and_batch_are_bit_identical(actuation: str) -> None:
     """References near and far (Newton and the fallback), and samples with no mode."""

@@ -27,6 +27,7 @@ import os
 import shlex
 import shutil
 import subprocess
+import sys
 import tempfile
 from collections.abc import Iterator
 from dataclasses import dataclass
@@ -93,6 +94,17 @@ PARALLEL_FLAGS: tuple[str, ...] = ("-flto=auto", "-flto-partition=balanced")
 #: (docs/derivatives.md). Its values are the same: no flag changes one.
 LARGE_UNIT = 1_000_000
 LIBS: tuple[str, ...] = ("-lm",)
+#: The optimisation level of a quick build, in place of -O3 (and without link-time
+#: optimisation): a first use runs on it while the optimised build goes on in the background
+#: (:func:`library_path`). gcc 12, 6-UPS main unit: 3 s of CPU at -O1, 25 s at -O3. The values
+#: are the same bit for bit: no flag that changes one is used at any level (ISO C99: no
+#: contraction; no reassociation without -ffast-math), as ``tests/test_c_build_modes.py`` checks.
+QUICK_LEVEL = "-O1"
+#: The environment variable of the build mode (:func:`build_mode`).
+BUILD_VARIABLE = "RPR3GEN_C_BUILD"
+#: ``background`` (the default): a quick build now, the optimised one in the background;
+#: ``optimised``: wait for the optimised build; ``quick``: quick builds only (tests, short runs).
+BUILD_MODES: tuple[str, ...] = ("background", "optimised", "quick")
 
 
 def cache_dir() -> Path:
@@ -163,10 +175,32 @@ def _exclusive(lock: Path) -> Iterator[None]:
         os.close(fd)  # releases the lock
 
 
-def library_path(variant: Variant, unit: str = "") -> Path:
-    """Path of the compiled library of ``variant``'s translation unit ``unit`` (``""``: the
-    main one), building it if it is not in the cache. A unit's library is linked to the main
-    library (whose public functions it may call), which is built first."""
+def build_mode() -> str:
+    """How a first use builds a library: ``$RPR3GEN_C_BUILD`` (:data:`BUILD_MODES`), by default
+    ``background``."""
+    mode = os.environ.get(BUILD_VARIABLE, "").strip().lower() or "background"
+    if mode not in BUILD_MODES:
+        raise SetupError(
+            f"{BUILD_VARIABLE}={mode!r}: must be one of {', '.join(BUILD_MODES)} (docs/c-abi.md)"
+        )
+    return mode
+
+
+@dataclass(frozen=True)
+class _Plan:
+    """One build of a unit: its files, flags and the library they make."""
+
+    target: Path
+    files: dict[str, bytes]
+    source: str
+    command: list[str]
+    cflags: tuple[str, ...]
+    link: tuple[str, ...]
+
+
+def _plan(variant: Variant, unit: str, quick: bool) -> _Plan:
+    """The build of ``unit`` at the optimised flags, or with ``quick`` the quick ones (-O1, no
+    link-time optimisation): the library's name is a digest of everything that makes it."""
     source, headers = sources(variant, unit)
     glue = shim(variant, unit)
     command = _compiler()
@@ -177,23 +211,78 @@ def library_path(variant: Variant, unit: str = "") -> Path:
     cflags = CFLAGS
     if unit and len(source) > LARGE_UNIT:
         cflags = tuple("-O0" if f == "-O3" else f for f in CFLAGS)
+    elif quick:
+        cflags = tuple(QUICK_LEVEL if f == "-O3" else f for f in CFLAGS)
     digest = hashlib.sha256()
     flags = " ".join(command + list(cflags) + list(LIBS) + list(link)).encode()
     for part in (source, *(headers[name] for name in sorted(headers)), glue, flags):
         digest.update(part)
         digest.update(b"\0")
-    folder = cache_dir()
     name = f"{variant.prefix}_{variant.variant}" + (f"_{unit}" if unit else "")
-    target = folder / f"lib{name}_{digest.hexdigest()[:20]}.so"
-    if target.is_file():
-        return target
-    folder.mkdir(parents=True, exist_ok=True)
-    with _exclusive(folder / f".{target.name}.lock"):
-        if not target.is_file():  # else built by another process while this one waited
-            files = {variant.files[_source_role(unit)]: source, **headers, "shim.c": glue}
-            source_name = variant.files[_source_role(unit)]
-            _build(variant, command, files, target, source_name, link, cflags)
-    return target
+    target = cache_dir() / f"lib{name}_{digest.hexdigest()[:20]}.so"
+    files = {variant.files[_source_role(unit)]: source, **headers, "shim.c": glue}
+    return _Plan(target, files, variant.files[_source_role(unit)], command, cflags, link)
+
+
+def _built(variant: Variant, plan: _Plan) -> Path:
+    """``plan``'s library, built first if the cache lacks it (once, under its lock)."""
+    if plan.target.is_file():
+        return plan.target
+    plan.target.parent.mkdir(parents=True, exist_ok=True)
+    with _exclusive(plan.target.parent / f".{plan.target.name}.lock"):
+        if not plan.target.is_file():  # else built by another process while this one waited
+            _build(variant, plan.command, plan.files, plan.target, plan.source, plan.link,
+                   plan.cflags, parallel=plan.cflags == CFLAGS)  # fmt: skip
+    return plan.target
+
+
+#: Optimised builds started in the background by this process: (variant folder, unit) -> the
+#: builder process.
+BACKGROUND: dict[tuple[Path, str], subprocess.Popen[bytes]] = {}
+
+
+def library_path(variant: Variant, unit: str = "") -> Path:
+    """Path of the compiled library of ``variant``'s translation unit ``unit`` (``""``: the
+    main one), building it if it is not in the cache. A unit's library is linked to the main
+    library (whose public functions it may call), which is built first.
+
+    The optimised library (:data:`CFLAGS`) when the cache has it. Else, by the build mode
+    (:func:`build_mode`): ``background`` builds a quick one (:data:`QUICK_LEVEL`: seconds, not
+    tens of seconds, and the same values bit for bit) for this process and starts the
+    optimised build in a process of its own, for the next first use; ``optimised`` builds the
+    optimised one and waits for it; ``quick`` builds the quick one only."""
+    optimised = _plan(variant, unit, quick=False)
+    if optimised.target.is_file():
+        return optimised.target
+    mode = build_mode()
+    if mode == "optimised":
+        return _built(variant, optimised)
+    quick = _plan(variant, unit, quick=True)
+    if quick.target == optimised.target:  # nothing to gain: a unit built at -O0 anyway
+        return _built(variant, optimised)
+    path = _built(variant, quick)
+    if mode == "background":
+        _optimise_later(variant, unit)
+    return path
+
+
+def _optimise_later(variant: Variant, unit: str) -> None:
+    """Start ``python -m rpr3gen.cbackend FOLDER VARIANT UNIT`` (the optimised build) in a
+    session of its own, quiet, once per process and unit; it outlives this process."""
+    key = (variant.folder, unit)
+    if key in BACKGROUND:
+        return
+    env = {**os.environ, BUILD_VARIABLE: "optimised"}
+    command = [sys.executable, "-m", "rpr3gen.cbackend", str(variant.folder.parent),
+               variant.variant, unit]  # fmt: skip
+    BACKGROUND[key] = subprocess.Popen(
+        command,
+        env=env,
+        stdin=subprocess.DEVNULL,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+        start_new_session=True,
+    )
 
 
 def _build(
@@ -204,14 +293,17 @@ def _build(
     source: str,
     link: tuple[str, ...] = (),
     cflags: tuple[str, ...] = CFLAGS,
+    parallel: bool = True,
 ) -> None:
     """Compile ``files`` (``source`` and the shim; ``link``: libraries and flags for the
-    linker) into ``target`` with ``cflags``: in a temporary folder beside it, then renamed."""
+    linker) into ``target`` with ``cflags`` (and ``parallel``: :data:`PARALLEL_FLAGS` first):
+    in a temporary folder beside it, then renamed."""
     with tempfile.TemporaryDirectory(dir=target.parent, prefix=".build-") as tmp:
         for name, text in files.items():
             (Path(tmp) / name).write_bytes(text)
         built = Path(tmp) / target.name
-        for extra in ((*EXTRA_FLAGS[0], *PARALLEL_FLAGS), *EXTRA_FLAGS):
+        lto = ((*EXTRA_FLAGS[0], *PARALLEL_FLAGS),) if parallel else ()
+        for extra in (*lto, *EXTRA_FLAGS):
             result = subprocess.run(
                 [*command, *cflags, *extra, source, "shim.c", "-o", built.name, *link, *LIBS],
                 cwd=tmp,
@@ -301,3 +393,17 @@ def library(variant: Variant) -> Library:
     if lib is None:
         lib = _LIBRARIES.setdefault(variant.folder, Library(variant))
     return lib
+
+
+def _main(argv: list[str]) -> int:
+    """``python -m rpr3gen.cbackend FOLDER VARIANT [UNIT]``: build that unit's optimised
+    library into the cache (what a first use starts in the background)."""
+    from rpr3gen import manifest
+
+    variant = manifest.load(argv[1], argv[0])
+    _built(variant, _plan(variant, argv[2] if len(argv) > 2 else "", quick=False))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(_main(sys.argv[1:]))
