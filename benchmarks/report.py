@@ -20,6 +20,26 @@ REPO = Path(__file__).resolve().parent.parent
 PAGE = REPO / "docs" / "performance.md"
 BEGIN = "<!-- performance: written by `python benchmarks/run.py --docs`; do not edit -->"
 END = "<!-- end of performance -->"
+SPATIAL_BEGIN = (
+    "<!-- spatial performance: written by `python benchmarks/run.py --structures spatial --docs` "
+    "or a full run's `--docs`; do not edit -->"
+)
+SPATIAL_END = "<!-- end of spatial performance -->"
+#: The spatial robots' measured functions, in the tables' order.
+SPATIAL_FUNCTIONS = ("inverse_dynamics", "forward_dynamics", "forward_kinematics")
+#: Issue 49's goals for the spatial robots: (what, variants, function, goal in ns).
+SPATIAL_GOALS = (
+    ("6-UPS inverse dynamics, every joint load, one call", ("ups_2",), "inverse_dynamics", 1000),
+    ("Delta inverse dynamics, every joint load, one call", ("rss2_1", "pss2_1"),
+     "inverse_dynamics", 300),
+    ("hexapod tracked forward kinematics, one call", ("ups_2", "rus_1", "pus_1"),
+     "forward_kinematics", 2000),
+)  # fmt: skip
+#: ``mj_forward`` against our forward dynamics' call, at least (issue 49).
+PEER_GOAL = 10.0
+#: The spatial robots' names in the tables, by variant (a variant not here: its name).
+ROBOTS = {"ups_2": "6-UPS", "rus_1": "6-RUS", "pus_1": "6-PUS", "rss2_1": "Delta (3-RSS2)",
+          "pss2_1": "linear Delta (3-PSS2)"}  # fmt: skip
 #: The tick's generated calls in the Python example (control_loop.py's Controller).
 TICK_CALLS = ("forward_kinematics", "platform_velocity", "actuator_efforts")
 #: The functions of the structures' compact table (the forward kinematics has no NumPy version
@@ -380,10 +400,84 @@ def structure_parts(r: dict[str, Any]) -> list[str]:
     ]  # fmt: skip
 
 
+def robot(r: dict[str, Any], v: str) -> str:
+    """``6-UPS `ups_2` (models/tsai-ups.toml)``: a spatial robot's row head."""
+    model = r["c"][f"{v}/trajectory"].get("model", "")
+    return f"{ROBOTS.get(v, v)} `{v}`" + (f" ({model})" if model else "")
+
+
+def mj_forward(r: dict[str, Any], v: str) -> float | None:
+    """MuJoCo's ``mj_forward`` on the spatial robot ``v``, ns a call (the best of the rounds)."""
+    found = r.get("mujoco", {}).get(v)
+    return None if found is None else float(found["results"]["mj_forward/single"]["min"])
+
+
+def spatial_targets(r: dict[str, Any]) -> str:
+    """Issue 49's goals, per spatial robot of the run."""
+    rows = []
+    for what, variants, f, goal in SPATIAL_GOALS:
+        for v in (v for v in variants if v in r.get("spatial", [])):
+            x = c_figures(r, f"{v}/trajectory")[f]["single"]
+            rows.append([f"{what} ({ROBOTS.get(v, v)})", ns(x), f"< {ns(goal)}",
+                         verdict(x, goal, True)])  # fmt: skip
+    for v in r.get("spatial", []):
+        mj, c = mj_forward(r, v), c_figures(r, f"{v}/trajectory")
+        if mj is None:
+            continue
+        fd, inv = c["forward_dynamics"]["single"], c["inverse_dynamics"]["single"]
+        rows.append([f"`mj_forward` / forward dynamics, one call ({ROBOTS.get(v, v)})",
+                     f"{ns(mj)} / {ns(fd)} = {mj / fd:.1f}x (inverse dynamics "
+                     f"{mj / inv:.0f}x)", f"≥ {PEER_GOAL:.0f}x",
+                     verdict(mj / fd, PEER_GOAL, False)])  # fmt: skip
+    return table(["target", "measured", "goal", "result"], rows)
+
+
+def spatial(r: dict[str, Any]) -> str:
+    """Per spatial robot and function: C single and batch, both floors and ``mj_forward``."""
+    rows = []
+    for v in r.get("spatial", []):
+        c, mj = c_figures(r, f"{v}/trajectory"), mj_forward(r, v)
+        chains = r["c"][f"{v}/trajectory"]["results"]
+        for k, f in enumerate(SPATIAL_FUNCTIONS):
+            if f not in c:
+                continue
+            x = c[f]
+            through = chains.get(f"{f}/chain", {}).get("kernel")
+            chain = ns(x["chain"]) + (f" (`{through}`)" if through else "") if "chain" in x else ""
+            rows.append([
+                robot(r, v) if k == 0 else "", f"`{f}`", ns(x["single"]), ns(x["batch"]),
+                f"{ns(x['floor'])}: {ratio(x['single'] / x['floor'])} / "
+                f"{ratio(x['batch'] / x['floor'])}",
+                f"{chain}: {ratio(x['single'] / x['chain'])}" if chain else "",
+                f"{ns(mj)}: {ratio(mj / x['single'])}" if mj else "", agreed(x),
+            ])  # fmt: skip
+    head = ["robot", "function", "C single", "C batch", "libm floor: single / batch",
+            "chain floor: single", "`mj_forward`: / single", "single = batch"]  # fmt: skip
+    flags = next((r["c"][f"{v}/trajectory"]["flags"] for v in r.get("spatial", [])), "")
+    version = next((x["version"] for x in r.get("mujoco", {}).values()), "?")
+    return (
+        f"`cc {flags}`; MuJoCo {version}. ns per call, best of the rounds; a ratio is the "
+        "column's floor (or `mj_forward`) against the call. *libm floor*: the `sin`, `cos`, "
+        "`sqrt`, `atan2` calls the kernel makes, the kernels it calls included (the forward "
+        "dynamics' `k + 1` inverse dynamics; the tracked forward kinematics' one Newton step: "
+        "two evaluations of `qa` and `J`); *chain floor*: the kernel's longest chain of "
+        "dependent operations, or where the kernel is not straight-line code, the longest of "
+        "the kernels it calls (named): a looser bound; *`mj_forward`*: MuJoCo's forward pass on "
+        "the exported robot at the same states, in C, how many times the call's time.\n\n"
+        + table(head, rows)
+    )
+
+
+def spatial_parts(r: dict[str, Any]) -> list[str]:
+    """The spatial robots' sections: the goals and the table."""
+    return ["\n## Spatial robots\n", spatial_targets(r), "\n", spatial(r)]
+
+
 def document(r: dict[str, Any]) -> str:
     parts = ["# Benchmark results\n", header(r)]
     parts += paper_parts(r) if paper(r) else []
     parts += structure_parts(r) if r.get("structures") else []
+    parts += spatial_parts(r) if r.get("spatial") else []
     return "".join(parts)
 
 
@@ -391,6 +485,10 @@ def docs_block(r: dict[str, Any]) -> str:
     every = ["**Every structure**:\n", structures(r)] if r.get("structures") else []
     return "\n".join([BEGIN, header(r), targets(r), functions(r, "revolute"), control_loop(r),
                       *every, END])  # fmt: skip
+
+
+def spatial_block(r: dict[str, Any]) -> str:
+    return "\n".join([SPATIAL_BEGIN, header(r), spatial_targets(r), spatial(r), SPATIAL_END])
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -406,8 +504,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     path.with_suffix(".md").write_text(document(r))
     if args.docs:
         text = PAGE.read_text()
-        pattern = re.compile(re.escape(BEGIN) + ".*?" + re.escape(END), re.S)
-        PAGE.write_text(pattern.sub(lambda _: docs_block(r), text, count=1))
+        if paper(r):
+            pattern = re.compile(re.escape(BEGIN) + ".*?" + re.escape(END), re.S)
+            text = pattern.sub(lambda _: docs_block(r), text, count=1)
+        if r.get("spatial"):
+            pattern = re.compile(re.escape(SPATIAL_BEGIN) + ".*?" + re.escape(SPATIAL_END), re.S)
+            text = pattern.sub(lambda _: spatial_block(r), text, count=1)
+        PAGE.write_text(text)
     return 0
 
 

@@ -7,7 +7,10 @@ in turn (``harness/paired.py``, a fresh process), the parts of the NumPy inverse
 time (``harness/numpy_parts.py``, another) and the Python benchmarks on pyperf
 (``harness/pybench.py``, one pyperf run per group, fresh worker processes); and for every one of
 the 18 structures, on its own model: its generation time (``harness/generation.py``: cold and
-cached, fresh interpreters), the same C per-function harness and NumPy per function (pyperf).
+cached, fresh interpreters), the same C per-function harness and NumPy per function (pyperf);
+and for every spatial robot of the gallery (the hexapods and Deltas of ``models/``), on its own
+model and trajectory: the same C harness on its inverse dynamics, forward dynamics and tracked
+forward kinematics, and MuJoCo's ``mj_forward`` on the same robot (``harness/mujoco.py``, in C).
 Variants that ``generated/`` lacks are derived into the run's own cache folder (a temporary
 ``RPR3GEN_CACHE_DIR``), never the user's. Writes ``benchmarks/results.json`` (every figure, the
 machine and its load average at the start and the end), then ``report.py`` turns it into
@@ -16,6 +19,8 @@ machine and its load average at the start and the end), then ``report.py`` turns
 ``--quick`` (fewer repeats) and ``--structures rrr_1,prr_1`` (those structures alone, without
 the paper's figures: about a minute a structure with ``--quick``) write ``results-quick.json``
 and ``results-quick.md`` instead, so that they never replace the committed full results.
+``--structures spatial`` (the spatial robots alone, about 5 minutes) writes
+``spatial-results.json`` and ``.md``, and with ``--docs`` the spatial block of the page.
 """
 
 from __future__ import annotations
@@ -38,7 +43,7 @@ import pyperf
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import report
-from harness import cbench, examples, generation, samples
+from harness import cbench, examples, generation, mujoco, samples
 
 BENCH = Path(__file__).resolve().parent
 REPO = BENCH.parent
@@ -163,31 +168,46 @@ def dump(value: Any, indent: str = "") -> str:
     return "{\n" + ",\n".join(items) + "\n" + indent + "}"
 
 
-def results_path(quick: bool) -> Path:
-    """Where a run's results go: ``results.json``, or ``results-quick.json`` (ignored by git) for
-    a quick or partial run, so that it never replaces the committed full results."""
-    return BENCH / ("results-quick.json" if quick else "results.json")
+def results_path(quick: bool, spatial: bool = False) -> Path:
+    """Where a run's results go: ``results.json``; ``spatial-results.json`` for a full run of
+    the spatial robots alone; or ``results-quick.json`` (ignored by git) for a quick or other
+    partial run, so that it never replaces the committed full results."""
+    if quick:
+        return BENCH / "results-quick.json"
+    return BENCH / ("spatial-results.json" if spatial else "results.json")
+
+
+def everything() -> tuple[str, ...]:
+    """Every structure a full run measures: the planar ones, then the spatial robots."""
+    return samples.structures() + samples.spatial()
 
 
 def chosen(text: str) -> tuple[str, ...]:
-    """The structures of ``--structures``: ``all`` or variant names, comma-separated."""
-    known = samples.structures()
+    """The structures of ``--structures``: ``all``, ``spatial`` or variant names (planar or
+    spatial), comma-separated."""
+    known = everything()
     if text == "all":
         return known
+    if text == "spatial":
+        return samples.spatial()
     names = tuple(dict.fromkeys(name.strip() for name in text.split(",")))
     unknown = [name for name in names if name not in known]
     if unknown:
         raise argparse.ArgumentTypeError(
-            f"not a structure: {', '.join(unknown)} (they are: all, {', '.join(known)})"
+            f"not a structure: {', '.join(unknown)} (they are: all, spatial, {', '.join(known)})"
         )
     return names
 
 
-def measure(results: dict[str, Any], structures: Sequence[str], quick: bool) -> None:
+def measure(results: dict[str, Any], selected: Sequence[str], quick: bool) -> None:
     """Every figure into ``results``: the paper's when every structure is measured, then the
-    structures'. The variants come from the cache folder ``$RPR3GEN_CACHE_DIR``."""
-    paper = samples.paper_variants() if tuple(structures) == samples.structures() else ()
-    results.update(paper=list(paper), structures=list(structures), c={}, generation={})
+    planar structures', then the spatial robots'. The variants come from the cache folder
+    ``$RPR3GEN_CACHE_DIR``."""
+    paper = samples.paper_variants() if tuple(selected) == everything() else ()
+    structures = [v for v in selected if v in samples.structures()]
+    spatial = [v for v in selected if v in samples.spatial()]
+    results.update(paper=list(paper), structures=structures, spatial=spatial, c={},
+                   generation={}, mujoco={})  # fmt: skip
     n, repeats = (20_000, 3) if quick else (100_000, 9)
     for variant in paper:
         for motion in samples.motions(variant):
@@ -202,6 +222,13 @@ def measure(results: dict[str, Any], structures: Sequence[str], quick: bool) -> 
         )
         log(f"{variant}: C functions")
         results["c"][f"{variant}/generic"] = cbench.run(variant, "generic", n, repeats)
+    for variant in spatial:
+        log(f"{variant}: C functions (its model's trajectory)")
+        # the forward dynamics takes microseconds: fewer samples, as many rounds
+        results["c"][f"{variant}/trajectory"] = cbench.run(variant, "trajectory", n // 5, repeats)
+        results["c"][f"{variant}/trajectory"]["model"] = samples.model_source(variant)
+        log(f"{variant}: mj_forward, in C")
+        results["mujoco"][variant] = mujoco.run(variant, repeats)
     if paper:
         log("control-loop examples")
         results["examples"] = examples.run(2 if quick else examples.RUNS)
@@ -210,7 +237,7 @@ def measure(results: dict[str, Any], structures: Sequence[str], quick: bool) -> 
         log("NumPy inverse dynamics, where the time goes")
         results["numpy_parts"] = run_harness("numpy_parts", quick)
     results["python"] = {}
-    for group in PYPERF if paper else ("structures",):
+    for group in PYPERF if paper else ("structures",) if structures else ():
         log(f"pyperf: {group}")
         results["python"].update(run_pyperf(group, quick, structures))
 
@@ -224,13 +251,15 @@ def main() -> int:
     )  # fmt: skip
     parser.add_argument(
         "--structures", type=chosen, default="all", metavar="LIST",
-        help="the structures measured: all (the default: a full run) or variant names, "
-             "comma-separated (rrr_1,prr_1: those alone, without the paper's figures)",
+        help="the structures measured: all (the default: a full run), spatial (the spatial "
+             "robots alone) or variant names, comma-separated (rrr_1,prr_1: those alone, "
+             "without the paper's figures)",
     )  # fmt: skip
     args = parser.parse_args()
-    partial = args.structures != samples.structures()
-    if args.docs and partial:
-        parser.error("--docs needs a run of every structure")
+    partial = args.structures != everything()
+    spatial = args.structures == samples.spatial()
+    if args.docs and partial and not spatial:
+        parser.error("--docs needs a run of every structure, or of the spatial robots alone")
     start = time.monotonic()
     results: dict[str, Any] = {"machine": machine(), "quick": args.quick,
                                "load_start": os.getloadavg()}  # fmt: skip
@@ -239,7 +268,7 @@ def main() -> int:
         measure(results, args.structures, args.quick)
     results["load_end"] = os.getloadavg()
     results["seconds"] = round(time.monotonic() - start)
-    out = results_path(args.quick or partial)
+    out = results_path(args.quick or (partial and not spatial), spatial)
     out.write_text(dump(results) + "\n")
     log(f"wrote {out.relative_to(REPO)}")
     report.main([str(out), *(["--docs"] if args.docs else [])])

@@ -223,3 +223,94 @@ def test_the_runs_go_round_the_cases(examples: ModuleType) -> None:
         at = [k for k, c in enumerate(order) if c == case]
         assert len(at) == 3
         assert all(b - a == len(cases) for a, b in itertools.pairwise(at))
+
+
+# A spatial forward dynamics calls the inverse dynamics' kernel k + 1 times (once, then in a
+# loop over the unit accelerations); a tracked forward kinematics evaluates its kinematics once,
+# then in Newton steps that stop early (its floor: one step, two evaluations).
+
+CALLER = """
+static int p_inner_kernel(const double *restrict params, double *restrict out)
+{
+    out[0] = sqrt(params[0]) + p_atan2(params[1], params[2]);
+    return 0;
+}
+
+static int p_fd_kernel(const double *restrict params, double *restrict out)
+{
+    int j;
+    status = p_inner_kernel(params, out);
+    for (j = 0; j < 6; ++j) {
+        status = p_inner_kernel(params, out);
+    }
+    return 0;
+}
+
+static int p_fk_kernel(const double *restrict params, double *restrict out)
+{
+    int iter;
+    int h;
+    if (p_inner_kernel(params, out) != 0) {
+        return 1;
+    }
+    for (iter = 0; iter < 30; ++iter) {
+        if (out[0] <= 1e-12) {
+            break;
+        }
+        for (h = 0; h <= 30; ++h) {
+            if (p_inner_kernel(params, out) == 0) {
+                break;
+            }
+        }
+    }
+    return 0;
+}
+"""
+
+
+def test_a_kernel_counts_the_calls_of_the_kernels_it_calls(cbench: ModuleType) -> None:
+    calls = cbench.kernel_calls(CALLER, "p")
+    assert calls["inner"] == {"sqrt": 1, "atan2": 1}
+    assert calls["fd"] == {"sqrt": 7, "atan2": 7}  # once, then six turns of a constant loop
+    assert calls["fk"] == {"sqrt": 2, "atan2": 2}  # loops that can stop early: one turn each
+
+
+def test_a_kernel_that_is_not_straight_line_takes_the_chain_of_the_kernels_it_calls(
+    cbench: ModuleType,
+) -> None:
+    lat = latencies(add=1.0, sqrt=10.0, atan2=100.0)
+    found = cbench.chains(CALLER, "p", lat, ["inner", "fd", "fk"])
+    assert found["inner/chain"] == {"min": 101.0}  # sqrt and atan2 side by side, then the add
+    assert found["fd/chain"] == {"min": 101.0, "kernel": "inner"}
+    assert found["fk/chain"] == {"min": 101.0, "kernel": "inner"}
+
+
+@pytest.mark.parametrize("variant", ["ups_2", "rss2_1"])
+def test_the_spatial_floors_follow_the_generated_program(
+    cbench: ModuleType, chain: ModuleType, repo_root: Path, variant: str
+) -> None:
+    """The forward dynamics makes k + 1 inverse dynamics' calls (k legs), the tracked forward
+    kinematics two evaluations of its kinematics; each has a chain floor, its callee's."""
+    source = (repo_root / "generated" / variant / "rpr3.c").read_text()
+    calls = cbench.kernel_calls(source, "rpr3")
+    legs = 6 if variant == "ups_2" else 3
+    inverse = calls["inverse_dynamics"]
+    assert inverse["sqrt"] > 0
+    assert calls["forward_dynamics"] == {f: (legs + 1) * k for f, k in inverse.items()}
+    kinematics = calls["actuator_coordinates_jacobian"]
+    assert calls["forward_kinematics"] == {f: 2 * k for f, k in kinematics.items()}
+    found = cbench.chains(source, "rpr3", latencies(add=1.0), list(calls))
+    assert found["forward_dynamics/chain"]["kernel"] == "inverse_dynamics"
+    assert found["forward_dynamics/chain"]["min"] == found["inverse_dynamics/chain"]["min"]
+    assert found["forward_kinematics/chain"]["kernel"] == "actuator_coordinates_jacobian"
+
+
+def test_the_latency_probe_times_the_math_kernels_a_source_defines(
+    cbench: ModuleType, repo_root: Path
+) -> None:
+    """A Delta's C has no sine: ``latency.c`` leaves it out rather than fail to link."""
+    hexapod = cbench.latency_kernels(repo_root / "generated" / "ups_2" / "rpr3.c")
+    delta = cbench.latency_kernels(repo_root / "generated" / "rss2_1" / "rpr3.c")
+    assert {"sin", "cos", "atan2", "fmin", "rint"} <= hexapod
+    assert "sin" not in delta
+    assert "atan2" in delta

@@ -50,3 +50,29 @@ def test_generic_motion_moves_every_coordinate_and_is_valid(samples: ModuleType)
     assert np.all(np.ptp(arrays["q"], axis=0) > 0.01)  # x, y and phi all move
     assert samples.valid("rrr_1", arrays)
     assert not samples.valid("rrr_1", samples.generic(301, 6.0))  # out of reach
+
+
+def test_every_spatial_robot_of_the_gallery_is_measured_on_its_trajectory(
+    samples: ModuleType,
+) -> None:
+    """The hexapods and Deltas of ``models/``, on their trajectories; the tracked forward
+    kinematics' reference is the pose one tick before. Only the committed variants are
+    evaluated (no derivation)."""
+    assert samples.spatial() == ("ups_2", "rus_1", "pus_1", "rss2_1", "pss2_1")
+    assert samples.gallery()["ups_2"].name == "tsai-ups.toml"
+    for variant in ("ups_2", "rss2_1"):
+        assert samples.motions(variant) == ("trajectory",)
+        arrays = samples.trajectory(variant, 401)
+        dof = 6 if variant == "ups_2" else 3
+        assert all(a.shape == (401, dof) and a.flags.c_contiguous for a in arrays.values())
+        assert np.all(np.ptp(arrays["q"], axis=0) > 0)  # every coordinate moves
+        step = np.abs(arrays["q"] - arrays["q_near"]).max()
+        assert 0 < step < np.abs(np.diff(arrays["q"], axis=0)).max() * 2  # a tick, not a sample
+        assert samples.measured(variant) == list(samples.SPATIAL_FUNCTIONS)
+        found, robot = samples.code(variant), samples.model(variant)
+        for name in samples.measured(variant):
+            f = found.function(name)
+            given = samples.inputs(variant, f, arrays)
+            assert [a.shape for a in given] == [(401, x.size) for x in f.inputs]
+            _, codes = rpr3gen.evaluate(robot, name, given, backend="c")
+            assert not np.any(codes), name

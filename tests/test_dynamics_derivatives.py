@@ -231,6 +231,6 @@ def test_the_cache_derives_the_derivatives_apart_on_their_first_call(
         ).read_bytes(), name
     assert cbackend.library_path(base) == cbackend.library_path(full)
 
-    with pytest.raises(rpr3gen.Rpr3genError, match="rpr3gen generate --out") as info:
+    with pytest.raises(rpr3gen.GeneratedCodeError, match="rpr3gen generate --out") as info:
         variants.load(model.structure, first, "inverse_dynamics_derivatives")
     assert "\n" not in str(info.value)

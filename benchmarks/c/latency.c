@@ -10,7 +10,8 @@
  * it). The functions are measured inside x = f(x) * a + b, which keeps x in their usual range
  * (the single call's fast paths: |x| < pi/4 for sin and cos), and that loop's multiply-add is
  * measured alone and subtracted. Prints JSON lines (timing.h): latency/NAME in ns, for the
- * names of benchmarks/harness/chain.py's LATENCIES.
+ * names of benchmarks/harness/chain.py's LATENCIES. A math kernel that this rpr3.c does not
+ * define (a Delta's has no sine) is left out: cbench.py passes -DLATENCY_NAME for each it has.
  */
 #include "timing.h"
 
@@ -65,11 +66,21 @@ static double chain_div(double x, size_t n)
 
 FRAMED(frame, x)
 FRAMED(sqrt, sqrt(x))
+#ifdef LATENCY_SIN
 FRAMED(sin, rpr3_sin(x))
+#endif
+#ifdef LATENCY_COS
 FRAMED(cos, rpr3_cos(x))
+#endif
+#ifdef LATENCY_ATAN2
 FRAMED(atan2, rpr3_atan2(x, 0.7))
+#endif
+#ifdef LATENCY_FMIN
 FRAMED(fmin, rpr3_fmin(x, 0.9))
+#endif
+#ifdef LATENCY_RINT
 FRAMED(rint, rpr3_rint(x * 8.0) * 0.125) /* two multiplies more: subtracted below */
+#endif
 
 /* Time per turn of a chain, ns: the best pass of `repeats` after a warm-up. */
 static double per_turn(chain_fn chain, size_t n, size_t repeats, double *sink)
@@ -107,11 +118,21 @@ int main(int argc, char **argv)
     report("mul", mul);
     report("div", per_turn(chain_div, n, repeats, &sink));
     report("sqrt", per_turn(chain_sqrt, n, repeats, &sink) - frame);
+#ifdef LATENCY_SIN
     report("sin", per_turn(chain_sin, n, repeats, &sink) - frame);
+#endif
+#ifdef LATENCY_COS
     report("cos", per_turn(chain_cos, n, repeats, &sink) - frame);
+#endif
+#ifdef LATENCY_ATAN2
     report("atan2", per_turn(chain_atan2, n, repeats, &sink) - frame);
+#endif
+#ifdef LATENCY_FMIN
     report("fmin", per_turn(chain_fmin, n, repeats, &sink) - frame);
+#endif
+#ifdef LATENCY_RINT
     report("rint", per_turn(chain_rint, n, repeats, &sink) - frame - 2.0 * mul);
+#endif
     fprintf(stderr, "latency: sink %g\n", sink);
     return 0;
 }

@@ -19,6 +19,7 @@ the functions, in the same build: what one call takes when it waits for nothing 
 from __future__ import annotations
 
 import json
+import math
 import os
 import re
 import shlex
@@ -45,25 +46,63 @@ LIBM = ("sin", "cos", "sqrt", "atan2")
 def kernel_calls(source: str, prefix: str) -> dict[str, dict[str, int]]:
     """libm calls (or the generated kernels standing for them) in each ``PREFIX_NAME_kernel``,
     per sample: a call inside a loop over the legs (``derive/codegen/backends/c/lanes.py``)
-    counts once per leg."""
-    calls = {}
-    for name, body in chain.kernel_bodies(source, prefix).items():
+    counts once per leg, one inside a loop of a constant count (``for (j = 0; j < 6; ++j) {``)
+    as often as the loop turns, but once in a loop that can stop early (a ``break``: the tracked
+    forward kinematics' Newton steps and their halvings, so that its floor is one Newton step);
+    a call of another kernel (a spatial forward dynamics' inverse dynamics) counts as that
+    kernel's calls."""
+    bodies = chain.kernel_bodies(source, prefix)
+    own: dict[str, dict[str, int]] = {}
+    called: dict[str, dict[str, int]] = {}
+    for name, body in bodies.items():
         found = dict.fromkeys(LIBM, 0)
-        legs, close = 1, None  # inside a lane loop: its calls run once per leg
-        for line in body.splitlines():
-            opened = LOOP.fullmatch(line.strip())
-            if opened:  # the loop's comment names its legs
-                legs = len(opened["legs"].split(", "))
-                close = line[: len(line) - len(line.lstrip())] + "}"
-            elif line == close:
-                legs, close = 1, None
+        kernels: dict[str, int] = {}
+        for line, times in turns(body.split("{", 1)[1]):  # after the signature
             for f in LIBM:
-                found[f] += legs * len(re.findall(rf"(?:\b|\b{prefix}_){f}(?:_fast)?\(", line))
+                found[f] += times * len(re.findall(rf"(?:\b|\b{prefix}_){f}(?:_fast)?\(", line))
             pairs = len(re.findall(rf"\b{prefix}_sincos(?:_fast)?\(", line))  # a sin and a cos
-            found["sin"] += legs * pairs
-            found["cos"] += legs * pairs
-        calls[name] = {f: k for f, k in found.items() if k}
-    return calls
+            found["sin"] += times * pairs
+            found["cos"] += times * pairs
+            for callee in chain.calls(line, prefix):
+                kernels[callee] = kernels.get(callee, 0) + times
+        own[name], called[name] = found, kernels
+
+    def total(name: str, seen: tuple[str, ...]) -> dict[str, int]:
+        found = dict(own[name])
+        for callee, times in called[name].items():
+            if callee in bodies and callee not in seen:
+                for f, k in total(callee, (*seen, callee)).items():
+                    found[f] += times * k
+        return found
+
+    return {name: {f: k for f, k in total(name, (name,)).items() if k} for name in bodies}
+
+
+#: A loop of a constant count, as the hand-written kernels write it.
+FOR = re.compile(r"for \((\w+) = 0; \1 (<=?) (\d+); \+\+\1\) \{")
+
+
+def turns(body: str) -> list[tuple[str, int]]:
+    """Each line of a kernel's body and how often it runs a call: the product of its enclosing
+    loops' turns (a lane loop's legs; a constant loop's count, or 1 if it can ``break``)."""
+    lines = body.splitlines()
+    result = []
+    open_: list[tuple[str, int]] = []  # (the closing line, turns) of each enclosing loop
+    for k, line in enumerate(lines):
+        times = math.prod(n for _, n in open_)
+        result.append((line, times))
+        text = line.strip()
+        close = line[: len(line) - len(line.lstrip())] + "}"
+        lane, loop = LOOP.fullmatch(text), FOR.match(text)
+        if lane:  # the loop's comment names its legs
+            open_.append((close, len(lane["legs"].split(", "))))
+        elif loop:
+            end = lines.index(close, k + 1) if close in lines[k + 1 :] else len(lines)
+            stops = any(x.strip() == "break;" for x in lines[k + 1 : end])
+            open_.append((close, 1 if stops else int(loop[3]) + (loop[2] == "<=")))
+        elif open_ and line == open_[-1][0]:
+            open_.pop()
+    return result
 
 
 def floor_body(calls: dict[str, int], size: int) -> list[str]:
@@ -133,10 +172,11 @@ static size_t batch_{n}(const double *p, const double *const *in, size_t n, doub
 
 
 def header(variant: str) -> tuple[str, list[str]]:
-    """``functions.h`` of a variant and the names of the functions it measures."""
+    """``functions.h`` of a variant and the names of the functions it measures
+    (:func:`harness.samples.measured`)."""
     found = samples.code(variant)
     calls = kernel_calls(found.path("c_source").read_text(), found.prefix)
-    names = [n for n, f in found.functions.items() if samples.measurable(found, f)]
+    names = samples.measured(variant)
     rows = []
     for n in names:
         f = found.function(n)
@@ -148,6 +188,13 @@ def header(variant: str) -> tuple[str, list[str]]:
     return text, names
 
 
+def latency_kernels(source: Path) -> set[str]:
+    """The math kernels (``sin``, ``cos``, ``atan2``, ``fmin``, ``rint``) that a generated C
+    source defines as ``PREFIX_NAME``: ``latency.c`` times these (a Delta's has no sine)."""
+    text = source.read_text()
+    return {k for k in chain.KERNELS if re.search(rf"\b\w+_{k}\(double \w+", text)}
+
+
 def parse(stdout: str) -> dict[str, dict[str, Any]]:
     """The JSON lines of a C benchmark, by name."""
     lines = (json.loads(line) for line in stdout.splitlines() if line.startswith("{"))
@@ -157,14 +204,24 @@ def parse(stdout: str) -> dict[str, dict[str, Any]]:
 def chains(
     source: str, prefix: str, latency: dict[str, float], names: list[str]
 ) -> dict[str, dict[str, float]]:
-    """The chain floor (:mod:`harness.chain`) of each function of ``names`` whose kernel is
-    straight-line code, ns, as result lines ``NAME/chain``."""
-    found = {}
+    """The chain floor (:mod:`harness.chain`) of each function of ``names``, ns, as result lines
+    ``NAME/chain``: its kernel's where it is straight-line code; else, where it calls kernels
+    that are (a spatial forward dynamics, a tracked forward kinematics), the longest of theirs,
+    named by ``"kernel"``: a looser lower bound, since the call waits for that kernel's
+    result and then does more."""
+    found: dict[str, dict[str, Any]] = {}
     bodies = chain.kernel_bodies(source, prefix)
     for name in names:
         length = chain.critical_path(bodies[name], latency, prefix)
         if length is not None:
             found[f"{name}/chain"] = {"min": length}
+            continue
+        inner = {c: chain.critical_path(bodies[c], latency, prefix)
+                 for c in sorted(chain.called(bodies[name], prefix)) if c in bodies}  # fmt: skip
+        known = {c: x for c, x in inner.items() if x is not None}
+        if known:
+            longest = max(known, key=lambda c: known[c])
+            found[f"{name}/chain"] = {"min": known[longest], "kernel": longest}
     return found
 
 
@@ -191,8 +248,9 @@ def run(variant: str, motion: str, n: int, repeats: int) -> dict[str, Any]:
             [*CC, *FLAGS, *include, str(C_DIR / "functions.c"), str(source), "-lm", "-o", str(exe)],
             check=True,
         )  # fmt: skip
-        subprocess.run([*CC, *FLAGS, *include, str(C_DIR / "latency.c"), "-lm", "-o", str(probe)],
-                       check=True)  # fmt: skip
+        have = [f"-DLATENCY_{k.upper()}" for k in chain.KERNELS if k in latency_kernels(source)]
+        subprocess.run([*CC, *FLAGS, *include, *have, str(C_DIR / "latency.c"), "-lm", "-o",
+                        str(probe)], check=True)  # fmt: skip
         done = subprocess.run(
             [str(exe), str(params), str(build), str(n), str(repeats)],
             capture_output=True, text=True, check=True,

@@ -63,6 +63,16 @@ def kernel_bodies(source: str, prefix: str) -> dict[str, str]:
     return bodies
 
 
+def calls(line: str, prefix: str) -> list[str]:
+    """The kernels a line of generated C calls (``PREFIX_NAME_kernel(...)``), by name."""
+    return re.findall(rf"\b{prefix}_(\w+)_kernel\(", line)
+
+
+def called(body: str, prefix: str) -> set[str]:
+    """The other kernels a kernel's ``body`` (:func:`kernel_bodies`) calls."""
+    return set(calls(body.split("{", 1)[1], prefix))
+
+
 def critical_path(body: str, latency: Mapping[str, float], prefix: str = "rpr3") -> float | None:
     """The longest chain of dependent operations of a kernel's ``body``, in the units of
     ``latency`` (``{name in LATENCIES: time}``); ``None`` when the body is not straight-line

@@ -1,6 +1,6 @@
 """What the benchmarks measure and on which samples: the variants, their models, the motions.
 
-Two kinds of variant are measured:
+Three kinds of variant are measured:
 
 - **the paper's** (``revolute``, ``prismatic``: the paper-format variants found in
   ``generated/``), on the paper's robot and two motions: the paper's platform rotation, eq. (3)
@@ -10,7 +10,12 @@ Two kinds of variant are measured:
   generic motion. The model is the gallery's file of that structure where ``models/`` has one
   (``rrr.toml`` is ``rrr_1``, ``paper-general.toml`` is ``rpr_1``, ...), else a random model of
   ``tests/planar_models.py`` drawn from the seed :data:`SEED`. A variant that ``generated/``
-  does not carry comes from the runtime's cache (``rpr3gen.variants``: derived on first use).
+  does not carry comes from the runtime's cache (``rpr3gen.variants``: derived on first use);
+- **every spatial robot of the gallery** (:func:`spatial`: the hexapods ``ups_2``, ``rus_1``,
+  ``pus_1``, the Deltas ``rss2_1``, ``pss2_1``), each on its file of ``models/`` and the
+  trajectory beside it (``tsai-ups.toml`` and ``tsai-ups.csv``, ...): the motion ``trajectory``
+  (:func:`trajectory`), with the pose one control tick (:data:`TICK`) earlier as the tracked
+  forward kinematics' reference ``q_near``.
 
 The generic motion: ``x``, ``y`` and ``phi`` each a sine, at incommensurate frequencies (periods
 3 s / (1, 1.3, 1.7)), amplitudes 30 mm, 25 mm and 0.2 rad times the variant's :func:`scale`:
@@ -42,6 +47,9 @@ REPO = Path(__file__).resolve().parents[2]
 #: Inputs the motions give directly: the pose, its velocity and its acceleration.
 MOTION_INPUTS = ("q", "qd", "qdd")
 MOTIONS = ("generic", "rotation")
+#: The tracked forward kinematics' reference: the pose this long before the sample's (s), as a
+#: 1 kHz control loop passes its previous solution.
+TICK = 1e-3
 #: The seed of the random models (``tests/planar_models.random_model``).
 SEED = 20
 #: The generic motion at scale 1: amplitudes (m, m, rad), rates (rad/s), phases (rad).
@@ -64,9 +72,20 @@ def structures() -> tuple[str, ...]:
     return tuple(s.variant for s in structure.ALL if not s.singular)
 
 
+@cache
+def spatial() -> tuple[str, ...]:
+    """The spatial robots' variants of the gallery (one model file each), in the runtime's order
+    of their leg types (``ups_2``, ``rus_1``, ``pus_1``, ``rss2_1``, ``pss2_1``)."""
+    order = list(structure.SPATIAL_LEG_TYPES)
+    found = [v for v in gallery() if Structure.of_variant(v).spatial]
+    return tuple(sorted(found, key=lambda v: (order.index(Structure.of_variant(v).leg), v)))
+
+
 def motions(variant: str) -> tuple[str, ...]:
-    """The motions a variant is measured on: both for the paper's, the generic one else."""
-    return MOTIONS if Structure.of_variant(variant).paper else ("generic",)
+    """The motions a variant is measured on: both for the paper's, the generic one for a planar
+    structure, the gallery's trajectory for a spatial robot."""
+    found = Structure.of_variant(variant)
+    return MOTIONS if found.paper else ("trajectory",) if found.spatial else ("generic",)
 
 
 def code(variant: str) -> Variant:
@@ -176,8 +195,28 @@ def scale(variant: str) -> float:
     raise RuntimeError(f"{variant}: no valid generic motion for {model_source(variant)}")
 
 
+def trajectory(variant: str, n: int) -> dict[str, np.ndarray]:
+    """The gallery's trajectory of a spatial robot (``models/NAME.csv`` beside its model file),
+    linearly interpolated at ``n`` instants over its whole duration: ``{"q", "qd", "qdd"}``, and
+    ``"q_near"``, the pose :data:`TICK` earlier (the first instant's own pose at the start)."""
+    path = gallery()[variant]
+    traj = rpr3gen.read_trajectory_csv(path.with_suffix(".csv"), pose=model(variant).structure.pose)
+    t = np.linspace(traj.t[0], traj.t[-1], n)
+
+    def at(times: np.ndarray, a: np.ndarray) -> np.ndarray:
+        columns = [np.interp(times, traj.t, a[:, k]) for k in range(a.shape[1])]
+        return np.ascontiguousarray(np.stack(columns, axis=1))
+
+    arrays = {k: at(t, a) for k, a in zip(MOTION_INPUTS, (traj.q, traj.qd, traj.qdd), strict=True)}
+    arrays["q_near"] = at(np.maximum(t - TICK, traj.t[0]), traj.q)
+    return arrays
+
+
 def motion(variant: str, name: str, n: int) -> dict[str, np.ndarray]:
-    """``{"q", "qd", "qdd"}``: (n, 3) C-contiguous float64 samples of a motion over 3 s."""
+    """``{"q", "qd", "qdd"}``: (n, dof) C-contiguous float64 samples of a motion (a spatial
+    robot's ``trajectory`` also gives ``q_near``)."""
+    if name == "trajectory":
+        return trajectory(variant, n)
     if name == "generic":
         return generic(n, scale(variant))
     traj = rpr3gen.paper_trajectory(name, samples=n, duration=3.0)
@@ -185,12 +224,22 @@ def motion(variant: str, name: str, n: int) -> dict[str, np.ndarray]:
     return {k: np.ascontiguousarray(a) for k, a in zip(MOTION_INPUTS, arrays, strict=True)}
 
 
+def dof(found: Variant) -> int:
+    """The size of the variant's pose ``q``: 3 (planar robots, Deltas) or 6 (hexapods)."""
+    return found.function("inverse_dynamics").inputs[0].size
+
+
+def direct(found: Variant, a: Any) -> bool:
+    """Whether the input ``a`` is given by the motion: the pose, its rates, the reference pose."""
+    return a.name in (*MOTION_INPUTS, "q_near") and a.size == dof(found)
+
+
 def producer(found: Variant, name: str, size: int) -> FunctionInfo | None:
     """The first function taking motion samples only with a public output ``name`` of ``size``
     components (``tau`` of ``actuator_efforts``, ``qa`` of ``actuator_coordinates``)."""
     for f in found.functions.values():
-        direct = all(a.name in MOTION_INPUTS and a.size == 3 for a in f.inputs)
-        if direct and any(o.name == name and o.size == size for o in f.public_outputs):
+        given = all(a.name in MOTION_INPUTS and a.size == dof(found) for a in f.inputs)
+        if given and any(o.name == name and o.size == size for o in f.public_outputs):
             return f
     return None
 
@@ -198,11 +247,25 @@ def producer(found: Variant, name: str, size: int) -> FunctionInfo | None:
 def measurable(found: Variant, f: FunctionInfo) -> bool:
     """Whether every input is a motion sample or another function's output, and the function
     is straight-line (has a NumPy version; the iterative forward kinematics has not)."""
-    inputs = all(
-        (a.name in MOTION_INPUTS and a.size == 3) or producer(found, a.name, a.size)
+    return f.numpy_function is not None and all(
+        (a.name in MOTION_INPUTS and a.size == dof(found)) or producer(found, a.name, a.size)
         for a in f.inputs
     )
-    return inputs and f.numpy_function is not None
+
+
+#: The spatial robots' measured functions (issue 49): the inverse dynamics with every joint
+#: load, the forward dynamics and the tracked forward kinematics (``q_near`` the pose one tick
+#: before).
+SPATIAL_FUNCTIONS = ("inverse_dynamics", "forward_dynamics", "forward_kinematics")
+
+
+def measured(variant: str) -> list[str]:
+    """The functions measured on ``variant``: every :func:`measurable` one of a planar variant,
+    :data:`SPATIAL_FUNCTIONS` of a spatial one."""
+    found = code(variant)
+    if Structure.of_variant(variant).spatial:
+        return [n for n in SPATIAL_FUNCTIONS if n in found.functions]
+    return [n for n, f in found.functions.items() if measurable(found, f)]
 
 
 def inputs(variant: str, f: FunctionInfo, arrays: dict[str, np.ndarray]) -> list[np.ndarray]:
@@ -210,7 +273,7 @@ def inputs(variant: str, f: FunctionInfo, arrays: dict[str, np.ndarray]) -> list
     found = code(variant)
     result: list[Any] = []
     for a in f.inputs:
-        if a.name in MOTION_INPUTS:
+        if direct(found, a):
             result.append(arrays[a.name])
             continue
         source = producer(found, a.name, a.size)

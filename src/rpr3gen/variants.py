@@ -33,7 +33,7 @@ from functools import cache
 from pathlib import Path
 
 from rpr3gen import manifest
-from rpr3gen.errors import InputError, SetupError
+from rpr3gen.errors import GeneratedCodeError, InputError, SetupError
 from rpr3gen.structure import Structure
 
 __all__ = ["cache_root", "ensure", "folder", "generator_hash", "load"]
@@ -158,7 +158,7 @@ def load(
     call; if the cache's variant defers it, the whole variant (derived on its first use).
 
     Raises:
-        Rpr3genError: ``generated`` is a folder that defers ``function`` (a cache folder).
+        GeneratedCodeError: ``generated`` is a folder that defers ``function`` (a cache's).
     """
     if generated is not None:
         found = manifest.load(structure.variant, generated)
@@ -169,7 +169,7 @@ def load(
     if function is None or function not in found.deferred:
         return found
     if generated is not None:
-        raise Rpr3genError(
+        raise GeneratedCodeError(
             f"{found.folder}: {function} is not in this folder (a cache's, derived without the "
             f"derivatives): generate the whole variant, rpr3gen generate --out {generated}"
         )
