@@ -18,14 +18,15 @@ def add_sums(lines: list[str], rows: list[str], legs: int) -> list[str]:
     per-sample checks): about half of that (``benchmarks/harness/numpy_parts.py``).
     """
     last: dict[str, int] = {}
-    patterns = {row: re.compile(rf"(?<![\w.]){re.escape(row)}") for row in rows}
+    wanted = set(rows)
+    assert all(ROW_PATTERN.match(row) for row in wanted), rows
     for index, line in enumerate(lines):
-        for row, pattern in patterns.items():
-            if pattern.search(line):
+        for row in _ROW.findall(line):  # each name[k] of the line, once
+            if row in wanted:
                 last[row] = index
         for name, start, stop in _SLICE.findall(line):  # the legs' rows at once: out[3:6]
             for k in range(int(start), int(stop)):
-                if f"{name}[{k}]" in patterns:
+                if f"{name}[{k}]" in wanted:
                     last[f"{name}[{k}]"] = index
     after: dict[int, list[int]] = {}
     for k, row in enumerate(rows):
@@ -40,6 +41,9 @@ def add_sums(lines: list[str], rows: list[str], legs: int) -> list[str]:
 
 
 _SLICE = re.compile(r"(?<![\w.])(\w+)\[(\d+):(\d+)\]")
+#: An array's row, ``name[k]``, not part of a longer name or an attribute (what a row of
+#: :func:`add_sums` is; one search of each line finds them all).
+_ROW = re.compile(r"(?<![\w.])(\w+\[\d+\])")
 ROW_PATTERN = re.compile(r"^(\w+)\[(\d+)\]$")
 
 
