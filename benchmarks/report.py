@@ -459,7 +459,7 @@ def spatial(r: dict[str, Any]) -> str:
         f"`cc {flags}`; MuJoCo {version}. ns per call, best of the rounds; a ratio is the "
         "column's floor (or `mj_forward`) against the call. *libm floor*: the `sin`, `cos`, "
         "`sqrt`, `atan2` calls the kernel makes, the kernels it calls included (the forward "
-        "dynamics' `k + 1` inverse dynamics; the tracked forward kinematics' one Newton step: "
+        "dynamics' one `efforts_matrix`; the tracked forward kinematics' one Newton step: "
         "two evaluations of `qa` and `J`); *chain floor*: the kernel's longest chain of "
         "dependent operations, or where the kernel is not straight-line code, the longest of "
         "the kernels it calls (named): a looser bound; *`mj_forward`*: MuJoCo's forward pass on "

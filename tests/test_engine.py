@@ -302,3 +302,30 @@ def test_a_modules_legs_are_distinct_capital_letters() -> None:
     for bad in ("ABA", "AbC", "A1"):
         with pytest.raises(ValueError, match="distinct capital letters"):
             ModuleSpec("p", "v", "doc", params, (), ok, legs=bad)
+
+
+def test_affine_parts_are_the_value_at_zero_and_the_derivative() -> None:
+    """``tangent.affine_parts`` on a toy program affine in ``a1, a2`` and not in ``x``: the
+    values at ``a = 0`` and the tangents are the expanded outputs' own; a statement that does
+    not read ``a`` is kept once, under its name, and a tangent that is an atom (zero, a symbol)
+    is no statement."""
+    from rpr3gen_derive.codegen.tangent import affine_parts
+
+    x, a1, a2 = sp.symbols("x a1 a2", real=True)
+    prog = Program()
+    s = prog.define("s", sp.sin(x) * x, "kinematics")
+    u = prog.define("u", s * a1 + x**2, "dynamics")
+    v = prog.define("v", u * sp.cos(x) + s * a2 - a1, "dynamics")
+    w = prog.define("w", v / s + u, "dynamics")
+    outputs = [w, v * x]
+    out, values, tangents = affine_parts(prog, outputs, [a1, a2], extra=[s + 1])
+    names = [str(asg.symbol) for asg in out.assignments]
+    # u's tangents are s and 0, v's second s, w's second 1: atoms, not statements
+    assert names == ["s", "u", "v", "v_t0", "w", "w_t0"]
+    zero = {a1: 0, a2: 0}
+    for i, expr in enumerate(outputs):
+        full = prog.expand(expr)
+        assert sp.simplify(out.expand(values[i]) - full.xreplace(zero)) == 0
+        for j, a in enumerate((a1, a2)):
+            assert sp.simplify(out.expand(tangents[i][j]) - sp.diff(full, a)) == 0
+    assert sp.simplify(out.expand(values[2]) - (sp.sin(x) * x + 1)) == 0

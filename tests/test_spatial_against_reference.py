@@ -239,6 +239,33 @@ def test_control_form_and_forward_dynamics(leg: str, backend: str) -> None:
 
 
 @pytest.mark.parametrize("leg", STRUCTURES)
+@pytest.mark.parametrize("backend", ["numpy", "c"])
+def test_efforts_matrix_is_the_references(leg: str, backend: str) -> None:
+    """``efforts_matrix``: ``tau0`` the reference's efforts at ``q'' = 0``, column ``j`` of
+    ``T`` the reference's at ``q'' = e_j`` less those (exact: the efforts are affine in
+    ``q''``); and ``T q'' + tau0`` the reference's efforts at ``q''``."""
+    data, model = _model(leg, 29)
+    q, qd, qdd = _motion(data, 29)
+    n, k = q.shape
+    legs = model.structure.legs
+    (T, tau0), codes = evaluate(model, "efforts_matrix", [q, qd], backend)
+    assert not codes.any()
+
+    def ref(acc: np.ndarray) -> np.ndarray:
+        out = sr.solve(data, q, qd, acc)
+        return np.column_stack([out[f"tau_{L}"] for L in legs])
+
+    at_rest = ref(np.zeros_like(q))
+    want = np.stack([ref(np.tile(np.eye(k)[j], (n, 1))) - at_rest for j in range(k)], axis=2)
+    scale = np.abs(want).max()
+    assert np.allclose(tau0, at_rest, rtol=1e-9, atol=1e-9 * np.abs(at_rest).max())
+    assert np.allclose(T.reshape(n, k, k), want, rtol=1e-9, atol=1e-9 * scale)
+    full = ref(qdd)
+    got = (T.reshape(n, k, k) @ qdd[:, :, np.newaxis])[:, :, 0] + tau0
+    assert np.allclose(got, full, rtol=1e-9, atol=1e-9 * np.abs(full).max())
+
+
+@pytest.mark.parametrize("leg", STRUCTURES)
 def test_numpy_equals_c(leg: str) -> None:
     data, model = _model(leg, 17)
     q, qd, qdd = _motion(data, 17)

@@ -11,8 +11,14 @@ function), then the inverse dynamics derivatives' kernel at that ``q''``, and so
 [-d tau/d q, -d tau/d q', I]`` by Gaussian elimination with partial pivoting; the runtime
 composes the same in NumPy.
 
-Both are in the C translation unit ``derivatives`` (:data:`UNIT`), with a header of their own,
-compiled apart and only when first called: they are several times the inverse dynamics' size.
+``efforts_matrix``: ``T = d tau / d q''`` and ``tau0``, the efforts at ``q'' = 0``, in one pass
+over the efforts' program (:mod:`.tangent`: the statements that read ``q''`` with one tangent
+per acceleration, the others once): the forward dynamics' and the control form's kernel, in the
+variant's main C unit.
+
+The derivatives are in the C translation unit ``derivatives`` (:data:`UNIT`), with a header of
+their own, compiled apart and only when first called: they are several times the inverse
+dynamics' size.
 The runtime's cache derives them apart too, when one is first called (:data:`NAMES`).
 """
 
@@ -22,6 +28,7 @@ import sympy as sp
 from rpr3gen_derive.codegen.adjoint import reverse_mode
 from rpr3gen_derive.codegen.program import Program
 from rpr3gen_derive.codegen.spec import Argument, Check, Component, FunctionSpec, Output
+from rpr3gen_derive.codegen.tangent import affine_parts
 
 #: The derivative functions, in the registries' order: a variant's derivation leaves them out
 #: when the runtime's cache asks it to (:attr:`ModuleSpec.deferred`), for a first use of one.
@@ -119,6 +126,46 @@ def inverse_dynamics_derivatives(efforts: FunctionSpec) -> FunctionSpec:
         checks=_guard_checks(efforts, renamed),
         unit=UNIT,
         straight=True,
+    )
+
+
+def efforts_matrix(efforts: FunctionSpec) -> FunctionSpec:
+    """``{prefix}_efforts_matrix``: the efforts of ``efforts`` (a function of ``q, qd, qdd``
+    with one output, the efforts, computed by its program) split as ``tau = T qdd + tau0``:
+    ``T = d tau / d qdd`` (row-major) and ``tau0`` (the efforts at ``qdd = 0``), from ``q`` and
+    ``qd`` in one pass (:func:`.tangent.affine_parts`), with ``efforts``' checks."""
+    q, qd, qdd = efforts.inputs
+    tau = efforts.public_outputs[0]
+    guard_exprs = _guards(efforts)
+    prog, values, jacobian = affine_parts(
+        efforts.program, list(tau.exprs), list(qdd.symbols), extra=guard_exprs
+    )
+    k = len(tau.exprs)
+    renamed = dict(zip(guard_exprs, values[k:], strict=True))
+    tau_arg = Argument(
+        tau.name, tuple(sp.Symbol(c.name) for c in tau.components), tau.components, tau.doc
+    )
+    return FunctionSpec(
+        name="efforts_matrix",
+        doc="The inverse dynamics' efforts split as tau = T qdd + tau0 (they are affine in the "
+        "accelerations): T = d tau / d qdd and tau0, the efforts at qdd = 0, from the pose q "
+        "and its rates qd in one pass (the statements that read qdd differentiated by it, the "
+        "kinematics shared).",
+        inputs=(q, qd),
+        outputs=(
+            _block("T", tau_arg, qdd, jacobian, "T = d tau / d qdd"),
+            Output(
+                "tau0",
+                tuple(values[:k]),
+                tuple(
+                    Component(f"{c.name}_0", c.unit, f"{c.meaning} at qdd = 0")
+                    for c in tau.components
+                ),
+                "the efforts at qdd = 0",
+            ),
+        ),
+        program=prog,
+        checks=_guard_checks(efforts, renamed),
     )
 
 

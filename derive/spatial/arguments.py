@@ -113,7 +113,7 @@ def efforts(structure: SpatialStructure) -> Argument:
     )
 
 
-def c_context(structure: SpatialStructure, forward: bool = False) -> tuple:
+def c_context(structure: SpatialStructure) -> tuple:
     d = derivation(structure)
     names = list(d.outputs)
     params = param_names(structure)
@@ -121,11 +121,5 @@ def c_context(structure: SpatialStructure, forward: bool = False) -> tuple:
         ("k", structure.dof),
         ("outputs", len(names)),
         ("tau", [names.index(f"tau_{leg}") for leg in structure.legs]),
-        ("loads", [params.index(n) for n in LOAD_PARAMS]),
         ("params", len(params)),
-        ("forward", forward),
     )
-
-
-#: The parameters of the loads that do not come from the motion: gravity and the payload.
-LOAD_PARAMS = ("gx", "gy", "gz", "fx", "fy", "fz", "mx", "my", "mz")

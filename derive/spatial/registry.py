@@ -240,12 +240,18 @@ def actuator_efforts(structure: SpatialStructure) -> FunctionSpec:
     )
 
 
+def efforts_matrix(structure: SpatialStructure) -> FunctionSpec:
+    """``rpr3_efforts_matrix``: ``T = d tau / d q''`` (row-major) and ``tau0``, the efforts at
+    ``q'' = 0``, in one pass over the efforts' program
+    (:func:`rpr3gen_derive.codegen.derivatives.efforts_matrix`)."""
+    return derivatives.efforts_matrix(_efforts_program(structure))
+
+
 def task_space_dynamics(structure: SpatialStructure) -> FunctionSpec:
     """``rpr3_task_space_dynamics``: ``M`` (row-major) and ``c``, ``M q'' + c = J^T tau``.
 
-    The efforts are affine in the acceleration, ``tau = T q'' + tau0``: ``tau0`` is the inverse
-    dynamics at ``q'' = 0``, ``T``'s column ``j`` the inverse dynamics at ``q'' = e_j`` with the
-    platform at rest and no gravity nor payload; ``M = J^T T``, ``c = J^T tau0``
+    The efforts are affine in the acceleration, ``tau = T q'' + tau0``, both parts from
+    :func:`efforts_matrix`' kernel; ``M = J^T T``, ``c = J^T tau0``
     (``templates/spatial_task_space.c.jinja``; the runtime composes the same in NumPy).
     """
     names = list(structure.pose)
@@ -254,8 +260,7 @@ def task_space_dynamics(structure: SpatialStructure) -> FunctionSpec:
         name="task_space_dynamics",
         doc="Dynamics in control form, M q'' + c = J^T tau in the pose's coordinates: M "
         "(row-major, symmetric positive definite) and c (Coriolis and centripetal terms, "
-        "gravity, payload), from k + 1 evaluations of the inverse dynamics (its efforts are "
-        "affine in q'').",
+        "gravity, payload), from the efforts' split tau = T q'' + tau0 (efforts_matrix).",
         inputs=pose_arguments(structure)[:2],
         outputs=(
             _matrix(
@@ -271,13 +276,13 @@ def task_space_dynamics(structure: SpatialStructure) -> FunctionSpec:
         program=Program(),
         checks=(Check("inputs_not_finite", "NOT_FINITE"), Check("custom", "SINGULAR")),
         c_body="spatial_task_space.c.jinja",
-        c_context=c_context(structure),
+        c_context=(("k", k), ("forward", False)),
     )
 
 
 def forward_dynamics(structure: SpatialStructure) -> FunctionSpec:
     """``rpr3_forward_dynamics``: ``q''`` under the efforts ``tau``: ``T q'' = tau - tau0``
-    (:func:`task_space_dynamics`' terms), by Gaussian elimination with partial pivoting."""
+    (:func:`efforts_matrix`' terms), by Gaussian elimination with partial pivoting."""
     tau = efforts(structure)
     acc = pose_arguments(structure)[2]
     return FunctionSpec(
@@ -294,7 +299,7 @@ def forward_dynamics(structure: SpatialStructure) -> FunctionSpec:
         program=Program(),
         checks=(Check("inputs_not_finite", "NOT_FINITE"), Check("custom", "SINGULAR")),
         c_body="spatial_task_space.c.jinja",
-        c_context=c_context(structure, forward=True),
+        c_context=(("k", structure.dof), ("forward", True)),
     )
 
 
@@ -417,6 +422,7 @@ FUNCTIONS: Mapping[str, FunctionBuilder] = {
     "actuator_jacobian": actuator_jacobian,
     "actuator_coordinates_jacobian": actuator_coordinates_jacobian,
     "actuator_efforts": actuator_efforts,
+    "efforts_matrix": efforts_matrix,
     "task_space_dynamics": task_space_dynamics,
     "forward_dynamics": forward_dynamics,
     "forward_kinematics": forward_kinematics,
