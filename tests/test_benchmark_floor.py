@@ -289,19 +289,21 @@ def test_a_kernel_that_is_not_straight_line_takes_the_chain_of_the_kernels_it_ca
 def test_the_spatial_floors_follow_the_generated_program(
     cbench: ModuleType, chain: ModuleType, repo_root: Path, variant: str
 ) -> None:
-    """The forward dynamics makes k + 1 inverse dynamics' calls (k legs), the tracked forward
-    kinematics two evaluations of its kinematics; each has a chain floor, its callee's."""
+    """The forward dynamics makes one call of the efforts' matrix and free terms
+    (``efforts_matrix``, one pass), whose libm calls are those of the inverse dynamics' efforts
+    at most; the tracked forward kinematics two evaluations of its kinematics; each has a chain
+    floor, its callee's."""
     source = (repo_root / "generated" / variant / "rpr3.c").read_text()
     calls = cbench.kernel_calls(source, "rpr3")
-    legs = 6 if variant == "ups_2" else 3
     inverse = calls["inverse_dynamics"]
     assert inverse["sqrt"] > 0
-    assert calls["forward_dynamics"] == {f: (legs + 1) * k for f, k in inverse.items()}
+    assert calls["forward_dynamics"] == calls["efforts_matrix"]
+    assert all(0 < k <= inverse[f] for f, k in calls["efforts_matrix"].items())
     kinematics = calls["actuator_coordinates_jacobian"]
     assert calls["forward_kinematics"] == {f: 2 * k for f, k in kinematics.items()}
     found = cbench.chains(source, "rpr3", latencies(add=1.0), list(calls))
-    assert found["forward_dynamics/chain"]["kernel"] == "inverse_dynamics"
-    assert found["forward_dynamics/chain"]["min"] == found["inverse_dynamics/chain"]["min"]
+    assert found["forward_dynamics/chain"]["kernel"] == "efforts_matrix"
+    assert found["forward_dynamics/chain"]["min"] == found["efforts_matrix/chain"]["min"]
     assert found["forward_kinematics/chain"]["kernel"] == "actuator_coordinates_jacobian"
 
 
