@@ -17,6 +17,7 @@ reported too. A figure is of this machine, in one run: compare rows with each ot
 
 from __future__ import annotations
 
+import os
 import platform
 import statistics
 import subprocess
@@ -30,6 +31,9 @@ import numpy as np
 import rpr3gen
 import rpr3gen.casadi as rc
 import rpr3gen.jax as rj
+
+#: Time the optimised C libraries, not the quick ones a first use runs on (rpr3gen.cbackend).
+os.environ.setdefault("RPR3GEN_C_BUILD", "optimised")
 
 ROOT = Path(__file__).resolve().parent.parent
 MODELS = {"rrr_1": ROOT / "models" / "rrr.toml", "ups_2": ROOT / "models" / "tsai-ups.toml"}

@@ -24,6 +24,9 @@ import rpr3gen
 from rpr3gen import manifest
 from rpr3gen.evaluators import evaluator
 
+#: Time the optimised C libraries, not the quick ones a first use runs on (rpr3gen.cbackend).
+os.environ.setdefault("RPR3GEN_C_BUILD", "optimised")
+
 FUNCTIONS = ("inverse_dynamics", "regressor", "payload_efforts")
 
 

@@ -45,6 +45,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import report
 from harness import cbench, examples, generation, mujoco, samples
 
+#: Time the optimised C libraries, not the quick ones a first use runs on (rpr3gen.cbackend).
+os.environ.setdefault("RPR3GEN_C_BUILD", "optimised")
+
 BENCH = Path(__file__).resolve().parent
 REPO = BENCH.parent
 #: pyperf's options per group, full run / quick run (None: skipped).
