@@ -1,7 +1,7 @@
 """The C build of a first use (``rpr3gen.cbackend.library_path``, docs/c-abi.md): a quick
-library (-O1) at once and the optimised one (-O3, link-time optimisation) in a process of its own,
-for the next first use; the two give the same bits for every function. And the build modes of
-``RPR3GEN_C_BUILD``."""
+library (-O1, or -O0 for a large unit) at once and the optimised one (-O3, link-time
+optimisation) in a process of its own, for the next first use; the three give the same bits for
+every function. And the build modes of ``RPR3GEN_C_BUILD``."""
 
 from __future__ import annotations
 
@@ -78,13 +78,20 @@ def test_a_first_use_runs_quick_and_optimises_in_the_background(
     assert cbackend.library_path(variant) == optimised  # found, not built again
     assert len(cbackend.BACKGROUND) == 1  # and nothing more started
     optimised_library = cbackend.Library(variant)
-    a = _outputs(quick_library, variant, model)
+    monkeypatch.setattr(cbackend, "QUICK_LARGE", 0)  # a quick build at -O0, as of a large unit
+    unoptimised = cbackend._plan(variant, "", quick=True)
+    assert "-O0" in unoptimised.cflags
+    monkeypatch.setattr(cbackend, "library_path", lambda variant, unit="": unoptimised.target)
+    cbackend._built(variant, unoptimised)
+    unoptimised_library = cbackend.Library(variant)
     b = _outputs(optimised_library, variant, model)
-    assert {"inverse_dynamics", "forward_dynamics", "assembly_modes"} <= set(a)
-    for name in a:
-        for x, y in zip(a[name], b[name], strict=True):
-            assert np.isfinite(x).any(), name
-            assert x.tobytes() == y.tobytes(), name
+    assert {"inverse_dynamics", "forward_dynamics", "assembly_modes"} <= set(b)
+    for library in (quick_library, unoptimised_library):
+        a = _outputs(library, variant, model)
+        for name in b:
+            for x, y in zip(a[name], b[name], strict=True):
+                assert np.isfinite(x).any(), name
+                assert x.tobytes() == y.tobytes(), name
 
 
 def test_the_quick_mode_starts_nothing_and_the_optimised_mode_waits(

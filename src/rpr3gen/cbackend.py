@@ -100,6 +100,11 @@ LIBS: tuple[str, ...] = ("-lm",)
 #: are the same bit for bit: no flag that changes one is used at any level (ISO C99: no
 #: contraction; no reassociation without -ffast-math), as ``tests/test_c_build_modes.py`` checks.
 QUICK_LEVEL = "-O1"
+#: A unit larger than this (bytes) is built at -O0 when quick: the hexapods' main units (0.8 to
+#: 1.1 MB since their forward dynamics' one-pass kernel). gcc 12, the 6-RUS's (1.08 MB): 0.9 s of
+#: CPU at -O0, 11.7 s at -O1; its inverse dynamics then 2.8 us a sample, 1.2 at -O1, 0.55 at -O3,
+#: for the first process only.
+QUICK_LARGE = 600_000
 #: The environment variable of the build mode (:func:`build_mode`).
 BUILD_VARIABLE = "RPR3GEN_C_BUILD"
 #: ``background`` (the default): a quick build now, the optimised one in the background;
@@ -199,8 +204,9 @@ class _Plan:
 
 
 def _plan(variant: Variant, unit: str, quick: bool) -> _Plan:
-    """The build of ``unit`` at the optimised flags, or with ``quick`` the quick ones (-O1, no
-    link-time optimisation): the library's name is a digest of everything that makes it."""
+    """The build of ``unit`` at the optimised flags, or with ``quick`` the quick ones (-O1, or -O0
+    over :data:`QUICK_LARGE`; no link-time optimisation): the library's name is a digest of
+    everything that makes it."""
     source, headers = sources(variant, unit)
     glue = shim(variant, unit)
     command = _compiler()
@@ -212,7 +218,8 @@ def _plan(variant: Variant, unit: str, quick: bool) -> _Plan:
     if unit and len(source) > LARGE_UNIT:
         cflags = tuple("-O0" if f == "-O3" else f for f in CFLAGS)
     elif quick:
-        cflags = tuple(QUICK_LEVEL if f == "-O3" else f for f in CFLAGS)
+        level = "-O0" if len(source) > QUICK_LARGE else QUICK_LEVEL
+        cflags = tuple(level if f == "-O3" else f for f in CFLAGS)
     digest = hashlib.sha256()
     flags = " ".join(command + list(cflags) + list(LIBS) + list(link)).encode()
     for part in (source, *(headers[name] for name in sorted(headers)), glue, flags):
