@@ -282,14 +282,16 @@ def _optimise_later(variant: Variant, unit: str) -> None:
     env = {**os.environ, BUILD_VARIABLE: "optimised"}
     command = [sys.executable, "-m", "rpr3gen.cbackend", str(variant.folder.parent),
                variant.variant, unit]  # fmt: skip
-    BACKGROUND[key] = subprocess.Popen(
-        command,
-        env=env,
-        stdin=subprocess.DEVNULL,
-        stdout=subprocess.DEVNULL,
-        stderr=subprocess.DEVNULL,
-        start_new_session=True,
-    )
+    # no process to spare (an embedded interpreter, a process limit): this process stays quick
+    with contextlib.suppress(OSError):
+        BACKGROUND[key] = subprocess.Popen(
+            command,
+            env=env,
+            stdin=subprocess.DEVNULL,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+            start_new_session=True,
+        )
 
 
 def _build(
