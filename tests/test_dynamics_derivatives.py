@@ -111,6 +111,10 @@ def _check(
 PLANAR = [("RRR", 1), ("PRR", 1), ("RPR", 1), ("RRP", 2), ("PRP", 1)]
 
 
+# Slow (run first): each derives its structure's whole variant (docs/derivatives.md), which the
+# tests of the same structure that run after it then find in the session's cache, instead of
+# deriving the variant without its derivatives first and the whole one again.
+@pytest.mark.slow
 @pytest.mark.parametrize("backend", ["numpy", "c"])
 @pytest.mark.parametrize(("leg", "actuated"), PLANAR)
 def test_planar_derivatives_against_the_reference(leg: str, actuated: int, backend: str) -> None:
@@ -152,6 +156,7 @@ def test_the_papers_robot_against_the_reference(actuation: str, backend: str) ->
 SPATIAL = ("RSS2", "PSS2", "UPS", "RUS", "PUS")
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("backend", ["numpy", "c"])
 @pytest.mark.parametrize("leg", SPATIAL)
 def test_spatial_derivatives_against_the_reference(leg: str, backend: str) -> None:
