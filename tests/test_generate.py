@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import hashlib
+import json
 import os
 import re
 import shutil
@@ -44,7 +46,7 @@ def _rendered(
         _RENDERS[key] = {
             path.relative_to(root).as_posix(): path.read_text(encoding="utf-8")
             for path in sorted(root.rglob("*"))
-            if path.is_file() and "__pycache__" not in path.parts
+            if path.is_file() and "__pycache__" not in path.parts and path.name != files.CHECKSUMS
         }
     if key not in _RENDERS:
         _RENDERS[key] = _RENDER(key)
@@ -72,7 +74,7 @@ def test_committed_generated_tree_is_current(
         env = dict(os.environ, PYTHONHASHSEED=_other_hash_seed())
         code = (
             "import sys; from rpr3gen.cli import main; "
-            "sys.exit(main(['generate', '--check', '--out', sys.argv[1]]))"
+            "sys.exit(main(['generate', '--check', '--render', '--out', sys.argv[1]]))"
         )
         out = repo_root / "generated"
         result = subprocess.run(
@@ -91,8 +93,8 @@ def test_committed_generated_tree_is_current(
         return dict(text)
 
     monkeypatch.setattr(generate, "render", render)
-    assert main(["generate", "--check", "--out", str(repo_root / "generated")]) == 0
-    assert "up to date" in capsys.readouterr().out
+    assert main(["generate", "--check", "--render", "--out", str(repo_root / "generated")]) == 0
+    assert "up to date (checked by a render)" in capsys.readouterr().out
 
 
 def _random_hash_seed() -> bool:
@@ -123,6 +125,55 @@ def test_check_detects_hand_edit(
     assert target.read_bytes() == before  # --check writes nothing
 
 
+def _no_render(*args: Any, **kwargs: Any) -> dict[str, str]:
+    raise AssertionError("rendered, where checksums.json tells")
+
+
+def test_check_of_an_unchanged_tree_reads_its_checksums_without_rendering(
+    repo_root: Path, capsys: pytest.CaptureFixture, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """checksums.json was written by a render of this generator, SymPy, Jinja2 and Python (the
+    committed tree's, which test_committed_generated_tree_is_current renders): ``--check``
+    reads it and renders nothing."""
+    monkeypatch.setattr(generate, "render", _no_render)
+    assert main(["generate", "--check", "--out", str(repo_root / "generated")]) == 0
+    assert "up to date (checked by checksums.json)" in capsys.readouterr().out
+
+
+def test_checksums_find_a_hand_edit_and_a_missing_file_without_rendering(
+    repo_root: Path, tmp_path: Path, capsys: pytest.CaptureFixture, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    copy = tmp_path / "generated"
+    shutil.copytree(repo_root / "generated", copy)
+    (copy / "rrr_1" / "rpr3.h").write_text("/* edited */\n", encoding="utf-8")
+    (copy / "ups_2" / "rpr3_derivatives.c").unlink()
+    monkeypatch.setattr(generate, "render", _no_render)
+    assert main(["generate", "--check", "--out", str(copy)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1
+    assert "rrr_1/rpr3.h" in err
+    assert "ups_2/rpr3_derivatives.c" in err
+    assert "revolute" not in err
+
+
+@pytest.mark.usefixtures("render_once")
+def test_checksums_of_another_render_key_are_not_trusted(
+    repo_root: Path, tmp_path: Path, capsys: pytest.CaptureFixture, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Another generator, SymPy, Jinja2 or Python may render other bytes: the check renders
+    (here the committed tree, what a render gives), and finds the hand edit the index hides."""
+    copy = tmp_path / "generated"
+    shutil.copytree(repo_root / "generated", copy)
+    target = copy / "prismatic" / "rpr3.c"
+    target.write_text(target.read_text() + "/* edited */\n")
+    index = json.loads((copy / files.CHECKSUMS).read_text())
+    index["files"]["prismatic/rpr3.c"] = hashlib.sha256(target.read_bytes()).hexdigest()
+    index["render_key"] = "0" * 64
+    (copy / files.CHECKSUMS).write_text(json.dumps(index))
+    assert main(["generate", "--check", "--out", str(copy)]) == 2
+    assert "prismatic/rpr3.c" in capsys.readouterr().err
+
+
 @pytest.mark.usefixtures("render_once")
 def test_check_detects_missing_file(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
     assert main(["generate", "--check", "--out", str(tmp_path / "nothing")]) == 2
@@ -136,7 +187,7 @@ def test_generate_then_check_round_trip(
     assert main(["generate", "--out", str(out)]) == 0
     assert main(["generate", "--check", "--out", str(out)]) == 0
     assert sorted(p.relative_to(out).as_posix() for p in out.rglob("*") if p.is_file()) == sorted(
-        render_once()
+        [*render_once(), files.CHECKSUMS]
     )
 
 

@@ -58,3 +58,61 @@ def write_files(out_dir: Path, files: dict[str, str]) -> list[str]:
             temporary.unlink(missing_ok=True)
         raise
     return changed
+
+
+#: The index of a generated tree (``rpr3gen generate`` writes it beside the variants): every
+#: file's SHA-256 and the key of the render that made them (:func:`render_key`), so that
+#: ``rpr3gen generate --check`` can tell an unchanged tree without rendering it again.
+CHECKSUMS = "checksums.json"
+
+
+def render_key(digest: str) -> str:
+    """What a render's bytes depend on: the generator's sources (``digest``), the installed
+    SymPy and Jinja2 (pinned by the ``derive`` extra) and Python's version. Two renders of the
+    same key give the same bytes (regeneration is deterministic, whatever the hash seed)."""
+    import sys
+
+    import jinja2
+    import sympy
+
+    text = (
+        f"{digest}\0sympy {sympy.__version__}\0jinja2 {jinja2.__version__}\0"
+        f"python {sys.version_info[0]}.{sys.version_info[1]}"
+    )
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+def checksums(files: dict[str, str], key: str) -> str:
+    """The text of :data:`CHECKSUMS` for the rendered ``files`` (``{relative path: text}``)."""
+    import json
+
+    data = {
+        "generated": "by rpr3gen generate: do not edit",
+        "render_key": key,
+        "files": {
+            rel: hashlib.sha256(text.encode()).hexdigest() for rel, text in sorted(files.items())
+        },
+    }
+    return json.dumps(data, indent=1) + "\n"
+
+
+def quick_stale(out_dir: Path, key: str) -> list[str] | None:
+    """The files of ``out_dir`` that differ from what its :data:`CHECKSUMS` records (edited by
+    hand, or missing), when that index is of the render key ``key``; None when there is no
+    index or it is of another key (another generator, SymPy, Jinja2 or Python: only a render
+    tells then)."""
+    import json
+
+    try:
+        data = json.loads((out_dir / CHECKSUMS).read_text(encoding="utf-8"))
+        recorded = dict(data["files"])
+        if data["render_key"] != key or not recorded:
+            return None
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
+    stale = []
+    for rel, digest in sorted(recorded.items()):
+        path = out_dir / rel
+        if not path.is_file() or hashlib.sha256(path.read_bytes()).hexdigest() != digest:
+            stale.append(rel)
+    return stale

@@ -56,7 +56,15 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     parser.add_argument(
         "--check",
         action="store_true",
-        help="write nothing; fail if the sources are stale (default: write them)",
+        help="write nothing; fail if the sources are stale (default: write them). The "
+        "committed tree is checked against its checksums.json when that was written by a "
+        "render of the same generator, SymPy, Jinja2 and Python, else rendered again",
+    )
+    parser.add_argument(
+        "--render",
+        action="store_true",
+        help="with --check: render the sources again and compare, even where checksums.json "
+        "would tell (default: off)",
     )
 
 
@@ -93,20 +101,36 @@ def run(args: argparse.Namespace) -> int:
         out_dir = Path(args.out) if args.out else generate.default_out_dir()
         if out_dir is None:
             raise SetupError("no source tree's generated/ folder here; name one with --out DIR")
+        key = codegen_files.render_key(generate.source_hash())
+        if args.check and not args.render:
+            known = codegen_files.quick_stale(out_dir, key)
+            if known is not None:
+                return _report(out_dir, known, "checksums.json")
         if not args.check:
             check_output(out_dir, "the generated sources", folder=True, argument="out")
         files = generate.render(generate.COMMITTED)
-    if args.check:
-        stale = codegen_files.stale_files(out_dir, files)
-        if stale:
-            raise GeneratedCodeError(
-                f"{out_dir}: stale or edited generated files: {', '.join(stale)}; "
-                "run `rpr3gen generate`"
+        if not args.check:
+            changed = codegen_files.write_files(
+                out_dir, {**files, codegen_files.CHECKSUMS: codegen_files.checksums(files, key)}
             )
-        print(f"{out_dir}: {len(files)} generated files up to date")
-        return 0
+            print(f"{out_dir}: {len(changed)} of {len(files) + 1} files changed")
+            return 0
+    if args.check:
+        return _report(out_dir, codegen_files.stale_files(out_dir, files), "a render", len(files))
     changed = codegen_files.write_files(out_dir, files)
     print(f"{out_dir}: {len(changed)} of {len(files)} files changed")
+    return 0
+
+
+def _report(out_dir: Path, stale: list[str], how: str, count: int | None = None) -> int:
+    """``--check``'s outcome: a line of success, or the stale files as an error."""
+    if stale:
+        raise GeneratedCodeError(
+            f"{out_dir}: stale or edited generated files: {', '.join(stale)}; "
+            "run `rpr3gen generate`"
+        )
+    files = "" if count is None else f"{count} "
+    print(f"{out_dir}: {files}generated files up to date (checked by {how})")
     return 0
 
 
