@@ -63,7 +63,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     parser.add_argument(
         "--render",
         action="store_true",
-        help="with --check: render the sources again and compare, even where checksums.json "
+        help="when checking, render the sources again and compare, even where checksums.json "
         "would tell (default: off)",
     )
 
