@@ -79,7 +79,7 @@ def test_a_first_use_runs_quick_and_optimises_in_the_background(
     assert len(cbackend.BACKGROUND) == 1  # and nothing more started
     optimised_library = cbackend.Library(variant)
     monkeypatch.setattr(cbackend, "QUICK_LARGE", 0)  # a quick build at -O0, as of a large unit
-    unoptimised = cbackend._plan(variant, "", quick=True)
+    unoptimised = cbackend._plans(variant, "")[1]
     assert "-O0" in unoptimised.cflags
     monkeypatch.setattr(cbackend, "library_path", lambda variant, unit="": unoptimised.target)
     cbackend._built(variant, unoptimised)
@@ -102,7 +102,7 @@ def test_the_quick_mode_starts_nothing_and_the_optimised_mode_waits(
     quick = cbackend.library_path(variant)
     assert quick.is_file()
     assert not cbackend.BACKGROUND
-    assert "-O1" in cbackend._plan(variant, "", quick=True).cflags
+    assert "-O1" in cbackend._plans(variant, "")[1].cflags
     assert cbackend.library_path(variant) == quick
 
 

@@ -203,10 +203,10 @@ class _Plan:
     link: tuple[str, ...]
 
 
-def _plan(variant: Variant, unit: str, quick: bool) -> _Plan:
-    """The build of ``unit`` at the optimised flags, or with ``quick`` the quick ones (-O1, or -O0
-    over :data:`QUICK_LARGE`; no link-time optimisation): the library's name is a digest of
-    everything that makes it."""
+def _plans(variant: Variant, unit: str) -> tuple[_Plan, _Plan]:
+    """The optimised build of ``unit`` and its quick one (-O1, or -O0 over :data:`QUICK_LARGE`;
+    no link-time optimisation), from one reading of its sources: a library's name is a digest
+    of everything that makes it."""
     source, headers = sources(variant, unit)
     glue = shim(variant, unit)
     command = _compiler()
@@ -214,21 +214,22 @@ def _plan(variant: Variant, unit: str, quick: bool) -> _Plan:
     if unit:
         main = library_path(variant)
         link = (str(main), f"-Wl,-rpath,{main.parent}")
-    cflags = CFLAGS
-    if unit and len(source) > LARGE_UNIT:
-        cflags = tuple("-O0" if f == "-O3" else f for f in CFLAGS)
-    elif quick:
-        level = "-O0" if len(source) > QUICK_LARGE else QUICK_LEVEL
-        cflags = tuple(level if f == "-O3" else f for f in CFLAGS)
-    digest = hashlib.sha256()
-    flags = " ".join(command + list(cflags) + list(LIBS) + list(link)).encode()
-    for part in (source, *(headers[name] for name in sorted(headers)), glue, flags):
-        digest.update(part)
-        digest.update(b"\0")
     name = f"{variant.prefix}_{variant.variant}" + (f"_{unit}" if unit else "")
-    target = cache_dir() / f"lib{name}_{digest.hexdigest()[:20]}.so"
     files = {variant.files[_source_role(unit)]: source, **headers, "shim.c": glue}
-    return _Plan(target, files, variant.files[_source_role(unit)], command, cflags, link)
+
+    def plan(level: str) -> _Plan:
+        cflags = tuple(level if f == "-O3" else f for f in CFLAGS)
+        digest = hashlib.sha256()
+        flags = " ".join(command + list(cflags) + list(LIBS) + list(link)).encode()
+        for part in (source, *(headers[name] for name in sorted(headers)), glue, flags):
+            digest.update(part)
+            digest.update(b"\0")
+        target = cache_dir() / f"lib{name}_{digest.hexdigest()[:20]}.so"
+        return _Plan(target, files, variant.files[_source_role(unit)], command, cflags, link)
+
+    optimised = plan("-O0" if unit and len(source) > LARGE_UNIT else "-O3")
+    quick = plan("-O0" if len(source) > QUICK_LARGE else QUICK_LEVEL)
+    return optimised, quick
 
 
 def _built(variant: Variant, plan: _Plan) -> Path:
@@ -258,14 +259,11 @@ def library_path(variant: Variant, unit: str = "") -> Path:
     tens of seconds, and the same values bit for bit) for this process and starts the
     optimised build in a process of its own, for the next first use; ``optimised`` builds the
     optimised one and waits for it; ``quick`` builds the quick one only."""
-    optimised = _plan(variant, unit, quick=False)
+    optimised, quick = _plans(variant, unit)
     if optimised.target.is_file():
         return optimised.target
     mode = build_mode()
-    if mode == "optimised":
-        return _built(variant, optimised)
-    quick = _plan(variant, unit, quick=True)
-    if quick.target == optimised.target:  # nothing to gain: a unit built at -O0 anyway
+    if mode == "optimised" or quick.target == optimised.target:  # or: a unit at -O0 anyway
         return _built(variant, optimised)
     path = _built(variant, quick)
     if mode == "background":
@@ -410,7 +408,7 @@ def _main(argv: list[str]) -> int:
     from rpr3gen import manifest
 
     variant = manifest.load(argv[1], argv[0])
-    _built(variant, _plan(variant, argv[2] if len(argv) > 2 else "", quick=False))
+    _built(variant, _plans(variant, argv[2] if len(argv) > 2 else "")[0])
     return 0
 
 
